@@ -1,0 +1,1 @@
+"""Results files (HDF5) and live or recorded views (Rerun)."""

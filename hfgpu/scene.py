@@ -1,0 +1,416 @@
+"""Scene files: TOML in, typed frozen configuration out, validated before any work starts.
+
+Contract keys (outside tools rely on them; extend, never rename): ``[run] end_time, physics``;
+``[rock] youngs_modulus, poisson_ratio, toughness, leakoff_coefficient, min_stress, [[rock.layers]]
+top, bottom, min_stress, toughness, leakoff_coefficient``; ``[fluid] viscosity, density``;
+``[injection] depth, schedule = [{until, rate, proppant, volume_fraction, concentration,
+end_concentration}]``; ``[mesh] cell_size``; ``[output] every``; ``[geometry]`` and ``[[proppant]]``
+(see :mod:`hfgpu.proppant.config`). Depth z is positive downward; x is along the fracture length.
+
+Physics-specific sections are parsed by their own folder (``hfgpu.fracture.config``,
+``hfgpu.proppant.config``), imported only when the scene asks for that physics.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+from .errors import SceneError
+from .scene_reader import Table
+
+PHYSICS = ("fracture", "proppant")
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    end_time: float
+    physics: tuple[str, ...]
+    seed: int = 0
+
+
+@dataclass(frozen=True)
+class Layer:
+    """A horizontal layer between depths ``top`` < ``bottom`` [m]; None means "use the rock's value"."""
+
+    top: float
+    bottom: float
+    min_stress: float | None = None
+    toughness: float | None = None
+    leakoff_coefficient: float | None = None
+
+
+@dataclass(frozen=True)
+class Rock:
+    youngs_modulus: float
+    poisson_ratio: float
+    toughness: float
+    leakoff_coefficient: float
+    min_stress: float
+    layers: tuple[Layer, ...] = ()
+
+    @property
+    def plane_strain_modulus(self) -> float:
+        """E' = E / (1 - nu^2), Eq. 1."""
+        return self.youngs_modulus / (1.0 - self.poisson_ratio**2)
+
+    def _layered(self, z: np.ndarray, name: str) -> np.ndarray:
+        """Property ``name`` at depths ``z``; the outermost layers extend to +-infinity."""
+        z = np.asarray(z, dtype=float)
+        out = np.full(z.shape, float(getattr(self, name)))
+        if not self.layers:
+            return out
+        ordered = sorted(self.layers, key=lambda layer: layer.top)
+        for i, layer in enumerate(ordered):
+            value = getattr(layer, name)
+            if value is None:
+                continue
+            top = -math.inf if i == 0 else layer.top
+            bottom = math.inf if i == len(ordered) - 1 else layer.bottom
+            out[(z >= top) & (z < bottom)] = value
+        return out
+
+    def min_stress_at(self, z: np.ndarray) -> np.ndarray:
+        """Minimum in-situ stress sigma_0(z) [Pa] from the layer table."""
+        return self._layered(z, "min_stress")
+
+    def toughness_at(self, z: np.ndarray) -> np.ndarray:
+        """K_Ic(z) [Pa m^0.5]."""
+        return self._layered(z, "toughness")
+
+    def leakoff_at(self, z: np.ndarray) -> np.ndarray:
+        """Carter coefficient C_L(z) [m/s^0.5]."""
+        return self._layered(z, "leakoff_coefficient")
+
+
+@dataclass(frozen=True)
+class Fluid:
+    viscosity: float
+    density: float = 1000.0
+
+
+@dataclass(frozen=True)
+class Stage:
+    """A piecewise-constant pumping stage ending at ``until`` [s] with fluid rate ``rate`` [m^3/s].
+
+    ``volume_fraction`` / ``end_volume_fraction`` is the proppant volume fraction of the slurry at the
+    start / end of the stage (linear ramp in time); 0 for a pad stage.
+    """
+
+    until: float
+    rate: float
+    proppant: str | None = None
+    volume_fraction: float = 0.0
+    end_volume_fraction: float = 0.0
+
+
+@dataclass(frozen=True)
+class Schedule:
+    stages: tuple[Stage, ...]
+
+    @property
+    def end(self) -> float:
+        return self.stages[-1].until if self.stages else 0.0
+
+    def stage_index(self, t: float) -> int:
+        """Index of the stage active during (t_prev, t]; -1 after the last stage (shut in)."""
+        for i, stage in enumerate(self.stages):
+            if t < stage.until:
+                return i
+        return -1
+
+    def rate(self, t: float) -> float:
+        """Injection rate Q(t) [m^3/s], constant within a stage, 0 after the last one."""
+        i = self.stage_index(t)
+        return 0.0 if i < 0 else self.stages[i].rate
+
+    def volume(self, t: float) -> float:
+        """Cumulative injected volume int_0^t Q dt [m^3] (exact for piecewise-constant Q)."""
+        total, start = 0.0, 0.0
+        for stage in self.stages:
+            if t <= start:
+                break
+            total += stage.rate * (min(t, stage.until) - start)
+            start = stage.until
+        return total
+
+    def mean_rate(self, t0: float, t1: float) -> float:
+        """(V(t1) - V(t0)) / (t1 - t0): the rate that injects exactly the scheduled volume over a step."""
+        return (self.volume(t1) - self.volume(t0)) / (t1 - t0)
+
+    def breakpoints(self) -> tuple[float, ...]:
+        return tuple(stage.until for stage in self.stages)
+
+    def proppant_fraction(self, t: float) -> tuple[str | None, float]:
+        """(class name, slurry volume fraction) injected at time t, ramped linearly within a stage."""
+        i = self.stage_index(t)
+        if i < 0:
+            return None, 0.0
+        stage = self.stages[i]
+        start = 0.0 if i == 0 else self.stages[i - 1].until
+        s = (t - start) / (stage.until - start)
+        return stage.proppant, stage.volume_fraction + s * (stage.end_volume_fraction - stage.volume_fraction)
+
+
+@dataclass(frozen=True)
+class Injection:
+    depth: float
+    schedule: Schedule
+    x: float = 0.0
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """Cell sizes [m]; ``max_cells_across`` caps the footprint's cells along x or z (the fracture grid
+    is coarsened 2x2 beyond it), None for no cap."""
+
+    dx: float
+    dz: float
+    max_cells_across: int | None = None
+
+
+@dataclass(frozen=True)
+class Output:
+    every: float
+    checkpoint_every: float | None = None
+
+
+@dataclass(frozen=True)
+class Scene:
+    run: RunConfig
+    fluid: Fluid
+    mesh: Mesh
+    output: Output
+    rock: Rock | None = None
+    injection: Injection | None = None
+    fracture: Any = None  # hfgpu.fracture.config.FractureNumerics when "fracture" in physics
+    proppant: Any = None  # hfgpu.proppant.config.ProppantSetup when "proppant" in physics
+    source: str = field(default="", repr=False, compare=False)  # the TOML text, stored in results
+
+    def has(self, physics: str) -> bool:
+        return physics in self.run.physics
+
+    def replace(self, **changes: Any) -> "Scene":
+        return dataclasses.replace(self, **changes)
+
+
+# ----------------------------------------------------------------------------------------------
+# parsing
+
+
+def load_scene(path_or_text: str | Path) -> Scene:
+    """Read and validate a scene from a TOML file path or TOML text.
+
+    Raises :class:`hfgpu.errors.SceneError` naming the key path, value and what is allowed.
+    """
+    text = _read_text(path_or_text)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError("(file)", str(path_or_text)[:80], f"not valid TOML: {exc}") from None
+    return parse_scene(data, source=text)
+
+
+def _read_text(path_or_text: str | Path) -> str:
+    if isinstance(path_or_text, Path):
+        return _read_file(path_or_text)
+    if "\n" in path_or_text or "=" in path_or_text:
+        return path_or_text
+    return _read_file(Path(path_or_text))
+
+
+def _read_file(path: Path) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise SceneError("(file)", str(path), f"cannot read the scene file: {exc.strerror}") from None
+
+
+def parse_scene(data: dict, source: str = "") -> Scene:
+    """Validate a parsed TOML document into a :class:`Scene`."""
+    top = Table(data, "")
+    run = _parse_run(top.table("run"))
+    fluid = _parse_fluid(top.table("fluid"))
+    mesh = _parse_mesh(top.table("mesh"))
+    output = _parse_output(top.table("output"), run.end_time)
+
+    rock = injection = fracture = proppant = None
+    needs_rock = "fracture" in run.physics
+    rock_table = top.table("rock") if needs_rock else top.table("rock", None)
+    if rock_table is not None:
+        rock = _parse_rock(rock_table)
+    injection_table = top.table("injection") if needs_rock else top.table("injection", None)
+    if "fracture" in run.physics:
+        from .fracture.config import parse_fracture_numerics
+
+        fracture = parse_fracture_numerics(top.table("fracture", {}))
+    if "proppant" in run.physics:
+        from .proppant.config import parse_proppant_setup
+
+        proppant = parse_proppant_setup(top, run=run, fluid=fluid, mesh=mesh)
+    else:
+        for key in ("proppant", "geometry", "mppic"):
+            if top.has(key):
+                top.raw(key)
+                raise SceneError(key, "(table)", 'this section needs "proppant" in run.physics')
+    if injection_table is not None:
+        densities = proppant.class_densities() if proppant is not None else {}
+        injection = _parse_injection(injection_table, densities)
+    top.finish()
+    return Scene(run=run, fluid=fluid, mesh=mesh, output=output, rock=rock, injection=injection,
+                 fracture=fracture, proppant=proppant, source=source)
+
+
+def _parse_run(t: Table) -> RunConfig:
+    end_time = t.quantity("end_time", "time", minimum=0.0, exclusive_minimum=True)
+    physics = t.raw("physics", ["fracture"])
+    if isinstance(physics, str):
+        physics = [physics]
+    if (not isinstance(physics, list) or not physics or len(set(physics)) != len(physics)
+            or any(p not in PHYSICS for p in physics)):
+        raise SceneError(t.key_path("physics"), physics,
+                         f"expected a non-empty list of distinct names from {list(PHYSICS)}")
+    seed = t.integer("seed", 0, minimum=0)
+    t.finish()
+    return RunConfig(end_time=end_time, physics=tuple(p for p in PHYSICS if p in physics), seed=seed)
+
+
+def _parse_fluid(t: Table) -> Fluid:
+    fluid = Fluid(
+        viscosity=t.quantity("viscosity", "viscosity", minimum=0.0, exclusive_minimum=True),
+        density=t.quantity("density", "density", 1000.0, minimum=0.0, exclusive_minimum=True),
+    )
+    t.finish()
+    return fluid
+
+
+def _parse_mesh(t: Table) -> Mesh:
+    size = t.raw("cell_size")
+    path = t.key_path("cell_size")
+    if isinstance(size, list):
+        if len(size) != 2:
+            raise SceneError(path, size, 'expected one length or two, ["dx", "dz"]')
+        sizes = [Table({"cell_size": s}, t.path).quantity("cell_size", "length", minimum=0.0,
+                                                          exclusive_minimum=True) for s in size]
+    else:
+        sizes = [t.quantity("cell_size", "length", minimum=0.0, exclusive_minimum=True)] * 2
+    cap = t.raw("max_cells_across", None)
+    if cap is not None:
+        cap = t.integer("max_cells_across", minimum=8)
+    t.finish()
+    return Mesh(dx=sizes[0], dz=sizes[1], max_cells_across=cap)
+
+
+def _parse_output(t: Table, end_time: float) -> Output:
+    every = t.quantity("every", "time", end_time / 10.0, minimum=0.0, exclusive_minimum=True)
+    checkpoint = t.quantity("checkpoint_every", "time", None, minimum=0.0, exclusive_minimum=True)
+    t.finish()
+    return Output(every=every, checkpoint_every=checkpoint)
+
+
+def _parse_rock(t: Table) -> Rock:
+    rock = dict(
+        youngs_modulus=t.quantity("youngs_modulus", "pressure", minimum=0.0, exclusive_minimum=True),
+        poisson_ratio=t.number("poisson_ratio", minimum=0.0, maximum=0.5, exclusive_maximum=True),
+        toughness=t.quantity("toughness", "toughness", 0.0, minimum=0.0),
+        leakoff_coefficient=t.quantity("leakoff_coefficient", "leakoff", 0.0, minimum=0.0),
+        min_stress=t.quantity("min_stress", "pressure", 0.0),
+    )
+    layers = []
+    for lt in t.tables("layers"):
+        layer = Layer(
+            top=lt.quantity("top", "length"),
+            bottom=lt.quantity("bottom", "length"),
+            min_stress=lt.quantity("min_stress", "pressure", None),
+            toughness=lt.quantity("toughness", "toughness", None, minimum=0.0),
+            leakoff_coefficient=lt.quantity("leakoff_coefficient", "leakoff", None, minimum=0.0),
+        )
+        if layer.bottom <= layer.top:
+            raise SceneError(lt.key_path("bottom"), lt.data["bottom"],
+                             f"a layer's bottom must lie below its top ({lt.data['top']!r}); depth is "
+                             "positive downward")
+        lt.finish()
+        layers.append(layer)
+    ordered = sorted(layers, key=lambda layer: layer.top)
+    for above, below in zip(ordered, ordered[1:]):
+        if below.top < above.bottom - 1e-12:
+            raise SceneError(f"{t.key_path('layers')}", f"{above.top}..{above.bottom} m and "
+                             f"{below.top}..{below.bottom} m", "layers must not overlap")
+    t.finish()
+    return Rock(layers=tuple(layers), **rock)
+
+
+def _parse_injection(t: Table, proppant_densities: dict[str, float]) -> Injection:
+    depth = t.quantity("depth", "length", 0.0)
+    x = t.quantity("x", "length", 0.0)
+    stages = []
+    start = 0.0
+    raw = t.raw("schedule")
+    if not isinstance(raw, list) or not raw:
+        raise SceneError(t.key_path("schedule"), raw, "expected a non-empty list of stages "
+                         '[{ until = "370 s", rate = "0.053 m**3/s" }, ...]')
+    for i, item in enumerate(raw):
+        st = Table(item, f"{t.key_path('schedule')}[{i}]")
+        if st.has("duration") and st.has("until"):
+            raise SceneError(st.key_path("duration"), item["duration"], "give either 'until' or "
+                             "'duration', not both")
+        if st.has("duration"):
+            until = start + st.quantity("duration", "time", minimum=0.0, exclusive_minimum=True)
+        else:
+            until = st.quantity("until", "time")
+        if until <= start:
+            raise SceneError(st.key_path("until"), item.get("until"), f"stages must end in increasing "
+                             f"time; this one must end after {start:g} s")
+        rate = st.quantity("rate", "rate", minimum=0.0)
+        name = st.raw("proppant", None)
+        fraction = end_fraction = 0.0
+        if name is not None:
+            if name not in proppant_densities:
+                raise SceneError(st.key_path("proppant"), name, "must name a [[proppant]] class: "
+                                 f"{sorted(proppant_densities) or 'none defined'}")
+            fraction, end_fraction = _stage_fractions(st, proppant_densities[name])
+        else:
+            for key in ("volume_fraction", "end_volume_fraction", "concentration", "end_concentration"):
+                if st.has(key):
+                    raise SceneError(st.key_path(key), item[key], "a proppant loading needs "
+                                     "'proppant = \"<class name>\"' in the same stage")
+        st.finish()
+        stages.append(Stage(until=until, rate=rate, proppant=name, volume_fraction=fraction,
+                            end_volume_fraction=end_fraction))
+        start = until
+    t.finish()
+    return Injection(depth=depth, schedule=Schedule(tuple(stages)), x=x)
+
+
+def _stage_fractions(st: Table, density: float) -> tuple[float, float]:
+    """Start/end slurry volume fraction of a stage from volume_fraction or concentration (ppa).
+
+    A concentration c [kg per m^3 of clean fluid] gives the slurry fraction (c/rho_p) / (1 + c/rho_p).
+    """
+    if st.has("volume_fraction") and st.has("concentration"):
+        raise SceneError(st.key_path("concentration"), st.data["concentration"],
+                         "give either 'volume_fraction' or 'concentration', not both")
+    bounds = dict(minimum=0.0, maximum=0.6)
+    if st.has("concentration"):
+        c0 = st.quantity("concentration", "concentration", minimum=0.0)
+        c1 = st.quantity("end_concentration", "concentration", c0, minimum=0.0)
+        fractions = [(c / density) / (1.0 + c / density) for c in (c0, c1)]
+        for key, f in zip(("concentration", "end_concentration"), fractions):
+            if f > bounds["maximum"]:
+                raise SceneError(st.key_path(key), st.data.get(key), "this loading gives a slurry "
+                                 f"volume fraction {f:.3f}; allowed: <= 0.6")
+        return fractions[0], fractions[1]
+    f0 = st.number("volume_fraction", **bounds)
+    f1 = st.number("end_volume_fraction", f0, **bounds)
+    return f0, f1

@@ -1,0 +1,118 @@
+"""Reading one TOML table of a scene with key paths in every error.
+
+:class:`Table` wraps a parsed TOML table and hands out checked values; each physics folder parses its
+own section with it, so the error format is the same everywhere. Keys a table does not know are an
+error too (a typo must not be silently ignored).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Iterable
+
+from .errors import MISSING, SceneError
+from .units import to_si
+
+
+class Table:
+    """A TOML table at key path ``path``; track which keys were read to reject unknown ones."""
+
+    def __init__(self, data: Any, path: str):
+        if not isinstance(data, dict):
+            raise SceneError(path, data, "expected a table")
+        self.data = data
+        self.path = path
+        self._read: set[str] = set()
+
+    def key_path(self, key: str) -> str:
+        return f"{self.path}.{key}" if self.path else key
+
+    def has(self, key: str) -> bool:
+        return key in self.data
+
+    def raw(self, key: str, default: Any = MISSING) -> Any:
+        self._read.add(key)
+        if key not in self.data:
+            if default is MISSING:
+                raise SceneError(self.key_path(key), MISSING, "this key is required")
+            return default
+        return self.data[key]
+
+    def quantity(self, key: str, kind: str, default: Any = MISSING, *, minimum: float | None = None,
+                 maximum: float | None = None, exclusive_minimum: bool = False,
+                 exclusive_maximum: bool = False) -> float:
+        """A physical value in SI, checked against bounds (``default`` may be None: then None is returned)."""
+        value = self.raw(key, default)
+        if value is None:
+            return None  # type: ignore[return-value]
+        number = to_si(value, kind, self.key_path(key))
+        check_bounds(self.key_path(key), value, number, kind, minimum, maximum,
+                     exclusive_minimum, exclusive_maximum)
+        return number
+
+    def number(self, key: str, default: Any = MISSING, **bounds: Any) -> float:
+        return self.quantity(key, "dimensionless", default, **bounds)
+
+    def integer(self, key: str, default: Any = MISSING, *, minimum: int | None = None,
+                maximum: int | None = None) -> int:
+        value = self.raw(key, default)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise SceneError(self.key_path(key), value, "expected an integer")
+        check_bounds(self.key_path(key), value, value, "dimensionless", minimum, maximum, False, False)
+        return value
+
+    def boolean(self, key: str, default: Any = MISSING) -> bool:
+        value = self.raw(key, default)
+        if not isinstance(value, bool):
+            raise SceneError(self.key_path(key), value, "expected true or false")
+        return value
+
+    def choice(self, key: str, choices: Iterable[str], default: Any = MISSING) -> str:
+        choices = tuple(choices)
+        value = self.raw(key, default)
+        if value not in choices:
+            raise SceneError(self.key_path(key), value, f"allowed: {', '.join(map(repr, choices))}")
+        return value
+
+    def string(self, key: str, default: Any = MISSING) -> str:
+        value = self.raw(key, default)
+        if not isinstance(value, str) or not value.strip():
+            raise SceneError(self.key_path(key), value, "expected a non-empty string")
+        return value
+
+    def table(self, key: str, default: Any = MISSING) -> "Table | None":
+        value = self.raw(key, default)
+        if value is None:
+            return None
+        return Table(value, self.key_path(key))
+
+    def tables(self, key: str) -> list["Table"]:
+        """An array of tables (``[[key]]`` or an inline list of tables); missing means empty."""
+        value = self.raw(key, [])
+        if not isinstance(value, list):
+            raise SceneError(self.key_path(key), value, "expected an array of tables ([[...]])")
+        return [Table(item, f"{self.key_path(key)}[{i}]") for i, item in enumerate(value)]
+
+    def finish(self) -> None:
+        """Raise on keys that were never read: they are typos or unsupported."""
+        unknown = sorted(set(self.data) - self._read)
+        if unknown:
+            known = ", ".join(sorted(self._read)) or "(none)"
+            raise SceneError(self.key_path(unknown[0]), self.data[unknown[0]],
+                             f"unknown key; keys allowed here: {known}")
+
+
+def check_bounds(path: str, raw: Any, number: float, kind: str, minimum: float | None,
+                 maximum: float | None, exclusive_minimum: bool, exclusive_maximum: bool) -> None:
+    """Raise a SceneError when ``number`` lies outside [minimum, maximum] (SI)."""
+    from .units import SI_UNITS
+
+    unit = SI_UNITS.get(kind, "")
+    low_bad = minimum is not None and (number <= minimum if exclusive_minimum else number < minimum)
+    high_bad = maximum is not None and (number >= maximum if exclusive_maximum else number > maximum)
+    if low_bad or high_bad:
+        parts = []
+        if minimum is not None:
+            parts.append(f"{'>' if exclusive_minimum else '>='} {minimum:g} {unit}".rstrip())
+        if maximum is not None:
+            parts.append(f"{'<' if exclusive_maximum else '<='} {maximum:g} {unit}".rstrip())
+        raise SceneError(path, raw, "allowed: " + " and ".join(parts))
