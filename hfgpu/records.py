@@ -1,0 +1,86 @@
+"""What a simulator hands to its output sink: snapshots and balance records (plain data, SI units).
+
+Simulators call, on any object with these methods (the HDF5 writer, a Rerun recorder, a test list):
+
+    sink.fracture_snapshot(FractureSnapshot)   # every [output] every, and at the end
+    sink.fracture_balance(BalanceRecord)        # every accepted time step
+    sink.proppant_snapshot(ProppantSnapshot)    # every [output] every, and at the end
+    sink.proppant_balance(SolidBalanceRecord)   # every fluid step
+
+Grid arrays are (nz, nx), row 0 at the shallowest depth z0, column 0 at x0 (centres of cell [0, 0]);
+depth z is positive downward.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class GridFrame:
+    """Placement of a uniform grid: cell sizes and the centre of cell [0, 0] [m]."""
+
+    dx: float
+    dz: float
+    x0: float
+    z0: float
+
+    def centres(self, nz: int, nx: int) -> tuple[np.ndarray, np.ndarray]:
+        """(x, z) cell-centre coordinates, each 1-D."""
+        return self.x0 + self.dx * np.arange(nx), self.z0 + self.dz * np.arange(nz)
+
+
+@dataclass(frozen=True)
+class FractureSnapshot:
+    """The fracture at one time.
+
+    width [m] is 0 outside the fracture; pressure [Pa] is the fluid pressure (0 outside);
+    leakoff_rate [m/s] is the leak-off volume rate per unit fracture area over the last step (Carter,
+    both faces); opening_time [s] is the time each cell opened (NaN outside).
+    """
+
+    time: float
+    frame: GridFrame
+    width: np.ndarray
+    pressure: np.ndarray
+    leakoff_rate: np.ndarray
+    opening_time: np.ndarray
+    extras: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class BalanceRecord:
+    """Fluid volume balance [m^3]: injected = stored + leaked (to the tolerance of the solver)."""
+
+    time: float
+    injected: float
+    stored: float
+    leaked: float
+
+
+@dataclass(frozen=True)
+class ProppantSnapshot:
+    """Parcels and grid fields of the MP-PIC model at one time.
+
+    parcels: 1-D arrays x, z [m], u, v [m/s], radius [m], density [kg/m^3], particles (per parcel),
+    state (0 suspended, 1 bridged/stopped), class_id (index into the scene's proppant classes).
+    grid: (nz, nx) volume_fraction, pressure [Pa], width [m]; fluid_u (nz, nx+1) on x-faces and
+    fluid_v (nz+1, nx) on z-faces [m/s].
+    """
+
+    time: float
+    frame: GridFrame
+    parcels: dict[str, np.ndarray]
+    grid: dict[str, np.ndarray]
+
+
+@dataclass(frozen=True)
+class SolidBalanceRecord:
+    """Proppant solid volume [m^3]: injected = in_domain + outflow (to round-off)."""
+
+    time: float
+    injected: float
+    in_domain: float
+    outflow: float
