@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import tomllib
+
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from hfgpu import SceneError, load_scene
+from hfgpu.scene import parse_scene
 from hfgpu.units import to_si
 
 BASE = """
@@ -118,3 +123,51 @@ def test_scene_is_frozen():
     scene = load_scene(BASE)
     with pytest.raises(AttributeError):
         scene.rock.toughness = 0.0
+
+
+# property-based: any malformed or out-of-range scene gives a SceneError, never another exception
+
+VALUES = st.one_of(
+    st.none(), st.booleans(), st.integers(-10**6, 10**6), st.floats(allow_nan=True, allow_infinity=True),
+    st.text(max_size=12), st.sampled_from(["40 GPa", "-3 MPa", "1e400 m", "nan s", "2 bbl/min", "0 s",
+                                           "5 furlongs", "3 m/s**0.5", "", "1 Pa*s"]),
+    st.lists(st.integers(), max_size=3), st.dictionaries(st.text(max_size=5), st.integers(), max_size=2),
+)
+
+
+def _leaves(data, path=()):
+    if isinstance(data, dict):
+        for key, value in data.items():
+            yield from _leaves(value, path + (key,))
+    elif isinstance(data, list) and data and all(isinstance(v, dict) for v in data):
+        for i, value in enumerate(data):
+            yield from _leaves(value, path + (i,))
+    else:
+        yield path
+
+
+LEAVES = list(_leaves(tomllib.loads(BASE)))
+
+
+def _set(data, path, value):
+    for key in path[:-1]:
+        data = data[key]
+    data[path[-1]] = value
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(st.sampled_from(LEAVES), VALUES), min_size=1, max_size=3))
+def test_corrupted_values_raise_scene_error_only(changes):
+    data = tomllib.loads(BASE)
+    for path, value in changes:
+        if value is None:
+            parent = data
+            for key in path[:-1]:
+                parent = parent[key]
+            parent.pop(path[-1], None)
+        else:
+            _set(data, path, value)
+    try:
+        parse_scene(data)
+    except SceneError as exc:
+        assert "scene key '" in str(exc)
