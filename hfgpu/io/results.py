@@ -1,0 +1,323 @@
+"""Results files: an HDF5 sink that survives a killed run, and a reader.
+
+Layout (docs/results-format.md is the full contract; extend, never rename)::
+
+    /                       attrs format="hfgpu-results", format_version, hfgpu_version, status
+    /scene                  the scene's TOML text (UTF-8 string)
+    /fracture/snapshots/000000 ...   attrs time, dx, dz, x0, z0; width, pressure, leakoff_rate, opening_time, extras
+    /fracture/balance       time, injected, stored, leaked (1-D, appended)
+    /proppant/snapshots/000000 ...   attrs time, dx, dz, x0, z0, n_parcels; per-parcel and grid datasets
+    /proppant/balance       time, injected, in_domain, outflow (1-D, appended)
+    /summary                attrs status, message, and the simulator's scalar summary values
+
+Integrity: the file is open only while a snapshot is written. A snapshot is built under a temporary
+name (``_incomplete``) and moved to its final zero-padded name once complete, then the file is flushed
+and closed; balance records are buffered and written with each snapshot (and at close). A run killed at
+any moment therefore leaves every completed snapshot readable; a leftover ``_incomplete`` group is
+ignored by the reader. ``status`` is "running" until :meth:`ResultsWriter.close` writes "complete" or
+"failed: <message>"; a file still saying "running" after its run ended was interrupted.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import h5py
+import numpy as np
+
+from ..errors import HfgpuError
+from ..records import (BalanceRecord, FractureSnapshot, GridFrame, ProppantSnapshot,
+                       SolidBalanceRecord)
+
+FORMAT = "hfgpu-results"
+FORMAT_VERSION = 1
+INCOMPLETE = "_incomplete"
+
+#: Units of every dataset name the writer knows (SI; "1" is dimensionless, "" is text or a label).
+UNITS = {
+    "time": "s", "injected": "m^3", "stored": "m^3", "leaked": "m^3", "in_domain": "m^3", "outflow": "m^3",
+    "width": "m", "pressure": "Pa", "leakoff_rate": "m/s", "opening_time": "s",
+    "net_pressure": "Pa", "min_stress": "Pa", "toughness": "Pa m^0.5", "leakoff_coefficient": "m/s^0.5",
+    "x": "m", "z": "m", "u": "m/s", "v": "m/s", "radius": "m", "density": "kg/m^3", "particles": "1",
+    "state": "1", "class_id": "1", "volume_fraction": "1", "fluid_u": "m/s", "fluid_v": "m/s",
+    "scene": "",
+}
+UNKNOWN_UNITS = "unspecified"
+
+FRACTURE_FIELDS = ("width", "pressure", "leakoff_rate", "opening_time")
+FRACTURE_BALANCE = ("time", "injected", "stored", "leaked")
+PROPPANT_BALANCE = ("time", "injected", "in_domain", "outflow")
+_BALANCE_FLUSH_ROWS = 4096
+_COMPRESS_ABOVE = 4096  # elements; smaller arrays are stored plainly
+
+
+def _open(path: Path, mode: str) -> h5py.File:
+    """h5py file without HDF5 file locking, so a reader can look at a file while a run writes it."""
+    return h5py.File(path, mode, locking=False)
+
+
+class ResultsWriter:
+    """Output sink writing an HDF5 results file (the sink methods of hfgpu/records.py).
+
+    The file at ``path`` is created (replaced if it exists) with the scene text and status "running".
+    Use as a context manager, or call :meth:`close` with the final status.
+    """
+
+    def __init__(self, path: str | Path, scene: Any):
+        from .. import __version__
+
+        self.path = Path(path)
+        self._counts = {"fracture": 0, "proppant": 0}
+        self._pending: dict[str, list[tuple[float, ...]]] = {"fracture": [], "proppant": []}
+        self._last_time = 0.0
+        self._closed = False
+        try:
+            with _open(self.path, "w") as f:
+                f.attrs.update(format=FORMAT, format_version=FORMAT_VERSION, hfgpu_version=__version__,
+                               status="running")
+                _dataset(f, "scene", np.array(getattr(scene, "source", "") or "", dtype=h5py.string_dtype()))
+        except OSError as exc:
+            raise HfgpuError(f"cannot create the results file '{self.path}': {exc}") from None
+
+    # sink methods ------------------------------------------------------------------------------
+
+    def fracture_snapshot(self, snap: FractureSnapshot) -> None:
+        """Write one fracture snapshot (and the buffered balance records)."""
+        fields = {name: getattr(snap, name) for name in FRACTURE_FIELDS}
+        clash = set(snap.extras) & set(fields)
+        if clash:
+            raise HfgpuError(f"fracture snapshot extras {sorted(clash)} clash with the standard fields")
+        fields.update(snap.extras)
+        self._snapshot("fracture", snap.time, snap.frame, {k: (v, "grid") for k, v in fields.items()}, {})
+
+    def proppant_snapshot(self, snap: ProppantSnapshot) -> None:
+        """Write one proppant snapshot: per-parcel datasets (kind "parcel") and grid datasets (kind "grid")."""
+        clash = set(snap.parcels) & set(snap.grid)
+        if clash:
+            raise HfgpuError(f"proppant snapshot names {sorted(clash)} are both parcel and grid fields")
+        data = {k: (v, "parcel") for k, v in snap.parcels.items()}
+        data.update({k: (v, "grid") for k, v in snap.grid.items()})
+        n = len(next(iter(snap.parcels.values()))) if snap.parcels else 0
+        self._snapshot("proppant", snap.time, snap.frame, data, {"n_parcels": n})
+
+    def fracture_balance(self, record: BalanceRecord) -> None:
+        """Buffer one fluid balance row; rows are written with the next snapshot or at close."""
+        self._balance("fracture", tuple(float(getattr(record, k)) for k in FRACTURE_BALANCE))
+
+    def proppant_balance(self, record: SolidBalanceRecord) -> None:
+        """Buffer one solid balance row; rows are written with the next snapshot or at close."""
+        self._balance("proppant", tuple(float(getattr(record, k)) for k in PROPPANT_BALANCE))
+
+    # ending -----------------------------------------------------------------------------------
+
+    def close(self, status: str = "complete", summary: dict[str, Any] | None = None) -> None:
+        """Write buffered rows, ``/summary`` (status, snapshot counts, scalar ``summary`` values), close."""
+        if self._closed:
+            return
+        self._closed = True
+        with _open(self.path, "a") as f:
+            self._write_balance(f)
+            for physics in self._counts:
+                f.pop(f"{physics}/snapshots/{INCOMPLETE}", None)
+            group = f.require_group("summary")
+            values = {k: v for k, v in (summary or {}).items() if _is_scalar(v)}
+            values.update(status=status, sim_time=self._last_time,
+                          fracture_snapshots=self._counts["fracture"],
+                          proppant_snapshots=self._counts["proppant"])
+            group.attrs.update(values)
+            f.attrs["status"] = status
+
+    def fail(self, message: str, summary: dict[str, Any] | None = None) -> None:
+        """Close with status "failed: <message>"."""
+        self.close(f"failed: {message}", summary)
+
+    def __enter__(self) -> "ResultsWriter":
+        return self
+
+    def __exit__(self, kind, exc, tb) -> None:
+        if exc is None:
+            self.close()
+        else:
+            self.fail(str(exc) or kind.__name__)
+
+    # internals --------------------------------------------------------------------------------
+
+    def _snapshot(self, physics: str, time: float, frame: GridFrame,
+                  data: dict[str, tuple[np.ndarray, str]], attrs: dict[str, Any]) -> None:
+        self._last_time = max(self._last_time, float(time))
+        with _open(self.path, "a") as f:
+            self._write_balance(f)
+            parent = f.require_group(f"{physics}/snapshots")
+            parent.pop(INCOMPLETE, None)
+            group = parent.create_group(INCOMPLETE)
+            group.attrs.update(time=float(time), dx=float(frame.dx), dz=float(frame.dz),
+                               x0=float(frame.x0), z0=float(frame.z0), **attrs)
+            for name, (array, kind) in data.items():
+                _dataset(group, name, _array(array)).attrs["kind"] = kind
+            parent.move(INCOMPLETE, f"{self._counts[physics]:06d}")
+            f.flush()
+        self._counts[physics] += 1
+
+    def _balance(self, physics: str, row: tuple[float, ...]) -> None:
+        self._last_time = max(self._last_time, row[0])
+        pending = self._pending[physics]
+        pending.append(row)
+        if len(pending) >= _BALANCE_FLUSH_ROWS:
+            with _open(self.path, "a") as f:
+                self._write_balance(f)
+
+    def _write_balance(self, f: h5py.File) -> None:
+        for physics, names in (("fracture", FRACTURE_BALANCE), ("proppant", PROPPANT_BALANCE)):
+            rows = self._pending[physics]
+            if not rows:
+                continue
+            columns = np.array(rows, dtype=np.float64).T
+            group = f.require_group(f"{physics}/balance")
+            for name, column in zip(names, columns):
+                if name not in group:
+                    _dataset(group, name, np.zeros(0), maxshape=(None,), chunks=(1024,))
+                ds = group[name]
+                ds.resize((ds.shape[0] + column.size,))
+                ds[-column.size:] = column
+            rows.clear()
+
+
+def _array(value: Any) -> np.ndarray:
+    """float64 for real data; integer labels (state, class_id) keep their type."""
+    array = np.asarray(value)
+    return array.astype(np.float64) if array.dtype.kind == "f" else array
+
+
+def _dataset(group: h5py.Group, name: str, data: np.ndarray, **options: Any) -> h5py.Dataset:
+    """Create dataset ``name`` with its ``units`` attribute (gzip-compressed when large)."""
+    if data.size > _COMPRESS_ABOVE and data.dtype.kind in "fiu" and "maxshape" not in options:
+        options.update(compression="gzip", compression_opts=1, shuffle=True)
+    ds = group.create_dataset(name, data=data, **options)
+    ds.attrs["units"] = UNITS.get(name, UNKNOWN_UNITS)
+    return ds
+
+
+def _is_scalar(value: Any) -> bool:
+    return isinstance(value, (bool, int, float, str, np.integer, np.floating))
+
+
+# ----------------------------------------------------------------------------------------------
+# reading
+
+
+class Snapshots(Sequence):
+    """The snapshots of one physics, in time order, read from the file on access (``len``, ``[i]``,
+    iteration, ``times``, :meth:`at`)."""
+
+    def __init__(self, path: Path, group: str, names: list[str], times: np.ndarray,
+                 build: Callable[[h5py.Group], Any]):
+        self._path, self._group, self._names, self._build = path, group, names, build
+        self.times = times
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+    def __getitem__(self, index):  # type: ignore[override]
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        name = self._names[index]
+        with _open(self._path, "r") as f:
+            return self._build(f[f"{self._group}/{name}"])
+
+    def at(self, time: float):
+        """The snapshot whose time is nearest to ``time`` [s]."""
+        if not len(self):
+            raise HfgpuError(f"{self._path}: no {self._group.split('/')[0]} snapshots")
+        return self[int(np.argmin(np.abs(self.times - time)))]
+
+
+@dataclass(frozen=True)
+class Results:
+    """A results file, read back. Arrays come from the file when asked for.
+
+    status: "complete", "failed: <message>", or "running" (still being written, or interrupted).
+    summary: the ``/summary`` attributes (empty until the run closed the file).
+    fracture_balance / proppant_balance: dicts of 1-D arrays (empty dict when absent).
+    """
+
+    path: Path
+    status: str
+    format_version: int
+    scene_text: str
+    summary: dict[str, Any]
+    fracture_snapshots: Snapshots
+    proppant_snapshots: Snapshots
+    fracture_balance: dict[str, np.ndarray] = field(repr=False)
+    proppant_balance: dict[str, np.ndarray] = field(repr=False)
+
+    @functools.cached_property
+    def scene(self):
+        """The stored scene, parsed again with :func:`hfgpu.load_scene`."""
+        from ..scene import load_scene
+
+        return load_scene(self.scene_text)
+
+
+def open_results(path: str | Path) -> Results:
+    """Open an hfgpu results file; raises :class:`HfgpuError` when it is missing or not one."""
+    path = Path(path)
+    try:
+        f = _open(path, "r")
+    except (OSError, FileNotFoundError) as exc:
+        raise HfgpuError(f"cannot open results file '{path}': {exc}") from None
+    with f:
+        if f.attrs.get("format") != FORMAT:
+            raise HfgpuError(f"'{path}' is not an hfgpu results file (no format=\"{FORMAT}\" attribute)")
+        scene = f["scene"][()] if "scene" in f else b""
+        return Results(
+            path=path,
+            status=str(f.attrs.get("status", "running")),
+            format_version=int(f.attrs["format_version"]),
+            scene_text=scene.decode("utf-8") if isinstance(scene, bytes) else str(scene),
+            summary={k: _plain(v) for k, v in f["summary"].attrs.items()} if "summary" in f else {},
+            fracture_snapshots=_snapshots(f, path, "fracture", _fracture_snapshot),
+            proppant_snapshots=_snapshots(f, path, "proppant", _proppant_snapshot),
+            fracture_balance=_balance(f, "fracture"),
+            proppant_balance=_balance(f, "proppant"),
+        )
+
+
+def _snapshots(f: h5py.File, path: Path, physics: str, build: Callable) -> Snapshots:
+    group = f.get(f"{physics}/snapshots")
+    names = sorted(n for n in group if n.isdigit()) if group is not None else []
+    times = np.array([group[n].attrs["time"] for n in names], dtype=np.float64)
+    return Snapshots(path, f"{physics}/snapshots", names, times, build)
+
+
+def _frame(group: h5py.Group) -> GridFrame:
+    a = group.attrs
+    return GridFrame(dx=float(a["dx"]), dz=float(a["dz"]), x0=float(a["x0"]), z0=float(a["z0"]))
+
+
+def _fracture_snapshot(group: h5py.Group) -> FractureSnapshot:
+    arrays = {name: group[name][()] for name in group}
+    return FractureSnapshot(time=float(group.attrs["time"]), frame=_frame(group),
+                            **{name: arrays.pop(name) for name in FRACTURE_FIELDS}, extras=arrays)
+
+
+def _proppant_snapshot(group: h5py.Group) -> ProppantSnapshot:
+    parts: dict[str, dict[str, np.ndarray]] = {"parcel": {}, "grid": {}}
+    for name, ds in group.items():
+        parts[ds.attrs["kind"]][name] = ds[()]
+    return ProppantSnapshot(time=float(group.attrs["time"]), frame=_frame(group), parcels=parts["parcel"],
+                            grid=parts["grid"])
+
+
+def _balance(f: h5py.File, physics: str) -> dict[str, np.ndarray]:
+    group = f.get(f"{physics}/balance")
+    return {name: ds[()] for name, ds in group.items()} if group is not None else {}
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, bytes):
+        return value.decode("utf-8")
+    return value.item() if isinstance(value, np.generic) else value
