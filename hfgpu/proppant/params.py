@@ -1,0 +1,81 @@
+"""Closure parameters of the MP-PIC particle phase (the paper, Eq. 10-16, 43; REFERENCE.md section 6)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import SceneError
+
+DRAG_LAWS = ("wen-yu", "snider")
+VISCOSITY_LAWS = ("power", "krieger-dougherty")
+
+
+@dataclass(frozen=True)
+class MppicParams:
+    """Frozen MP-PIC closure constants; checked on construction (SceneError names ``mppic.<field>``).
+
+    theta_cp: close-packing volume fraction (Eq. 10, 16). P_s [Pa], beta, epsilon: Harris-Crighton stress
+    Eq. 16 (paper: 4 Pa, 2, 1e-7). restitution: e of the O'Rourke & Snider (2010) damping time.
+    drag_law: "wen-yu" = the paper's Eq. 14 with ``drag_re_coefficient`` in front of Re^0.687 (the paper
+    prints 0.5; Schiller-Naumann / Wen-Yu is 0.15, the default); "snider" = Snider (2001)
+    C_d = 24/Re (theta_f^-2.65 + Re^(2/3) theta_f^-1.78 / 6) (REFERENCE.md 6.2).
+    viscosity_law: slurry viscosity for the fluid: "power" = Eq. 10 with ``viscosity_exponent`` (-1.82),
+    "krieger-dougherty" = (1 - theta/theta_cp)^(-2.5 theta_cp).
+    bridging_factor: a parcel stops where the width of its cell < bridging_factor x its diameter. Default 2:
+    the lower end of the 2-3 diameters commonly quoted for bridging of a particle stream in a slot
+    (van der Vlis et al. 1975; Gruesbeck & Collins 1982), lower so that parcels are not stopped early.
+    drag_iterations: fixed-point iterations on D_p(u_p) in Eq. 43 (>= 1).
+    packing_restitution: e of the packing limiter (Snider 2001 eqs. 39-41; MFIX MPPIC_COEFF_EN1): a parcel
+    driven into a denser region faster than the mean parcel velocity is sent back at most e times its
+    relative velocity. Default 0 (inelastic): a bed whose stress carries its weight is then exactly at rest.
+    damping: collision damping on/off; active only where theta_p > damping_threshold x theta_cp.
+    """
+
+    theta_cp: float = 0.6
+    P_s: float = 4.0
+    beta: float = 2.0
+    epsilon: float = 1e-7
+    restitution: float = 0.9
+    drag_law: str = "wen-yu"
+    drag_re_coefficient: float = 0.15
+    viscosity_law: str = "power"
+    viscosity_exponent: float = -1.82
+    bridging_factor: float = 2.0
+    drag_iterations: int = 3
+    packing_restitution: float = 0.0
+    damping: bool = True
+    damping_threshold: float = 0.5
+
+    def __post_init__(self) -> None:
+        def bad(name: str, allowed: str) -> SceneError:
+            return SceneError(f"mppic.{name}", getattr(self, name), allowed)
+
+        if not 0.0 < self.theta_cp < 1.0:
+            raise bad("theta_cp", "allowed: 0 < theta_cp < 1")
+        for name in ("P_s", "epsilon"):
+            if not getattr(self, name) > 0.0:
+                raise bad(name, "allowed: a number > 0")
+        for name in ("beta", "drag_re_coefficient", "bridging_factor"):
+            if not getattr(self, name) >= 0.0:
+                raise bad(name, "allowed: a number >= 0")
+        for name in ("restitution", "packing_restitution"):
+            if not 0.0 <= getattr(self, name) <= 1.0:
+                raise bad(name, f"allowed: 0 <= {name} <= 1")
+        if self.drag_law not in DRAG_LAWS:
+            raise bad("drag_law", f"allowed: one of {list(DRAG_LAWS)}")
+        if self.viscosity_law not in VISCOSITY_LAWS:
+            raise bad("viscosity_law", f"allowed: one of {list(VISCOSITY_LAWS)}")
+        if not self.viscosity_exponent < 0.0:
+            raise bad("viscosity_exponent", "allowed: a number < 0 (viscosity grows with theta_p)")
+        if isinstance(self.drag_iterations, bool) or not isinstance(self.drag_iterations, int) \
+                or self.drag_iterations < 1:
+            raise bad("drag_iterations", "allowed: an integer >= 1")
+        if not isinstance(self.damping, bool):
+            raise bad("damping", "allowed: true or false")
+        if not 0.0 <= self.damping_threshold <= 1.0:
+            raise bad("damping_threshold", "allowed: 0 <= damping_threshold <= 1")
+
+    @property
+    def drag_law_code(self) -> int:
+        """Integer code of the drag law for kernels: 0 wen-yu (Eq. 14), 1 snider."""
+        return DRAG_LAWS.index(self.drag_law)

@@ -1,0 +1,272 @@
+"""MP-PIC particle operations, NumPy reference (test oracle of the Taichi kernels in ``hfgpu.kernels``).
+
+Grid-side steps that cost O(cells) (finishing the scattered moments, face gradients, damping rates) are shared
+by both backends; the per-parcel steps (``moment_sums``, ``gather``, ``push``, ``exchange``) have a NumPy
+version here and a Taichi version in ``kernels/particles.py``. See ``backend.py`` for the API.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..records import GridFrame
+from . import closures
+from .interpolation import active_nodes, deposit, face_widths, interpolate, owning_cell, weights
+from .params import MppicParams
+from .parcels import BRIDGED, SUSPENDED, Parcels
+
+#: channels of the scattered per-cell sums, in order
+MOMENT_CHANNELS = ("volume", "mass", "mass_u", "mass_v", "mass_speed2", "n_r3", "n_r2")
+
+
+@dataclass(frozen=True)
+class CellMoments:
+    """Per-cell parcel statistics (nz, nx) from the scatter (bilinear cell weights, Eq. 38).
+
+    volume_fraction theta_p = sum n V_p I / (dx dz w) (Eq. 38; 0 in closed cells); solid_volume = sum n V_p I
+    [m^3]; mass [kg]; mean_u, mean_v: mass-averaged velocity; velocity_variance: mass-weighted mean of
+    |u - mean|^2 [m^2/s^2]; sauter_radius r32 = sum n r^3 / sum n r^2 [m] (0 where no parcel).
+    """
+
+    volume_fraction: np.ndarray
+    solid_volume: np.ndarray
+    mass: np.ndarray
+    mean_u: np.ndarray
+    mean_v: np.ndarray
+    velocity_variance: np.ndarray
+    sauter_radius: np.ndarray
+
+
+@dataclass(frozen=True)
+class GridFields:
+    """Node fields the gather and push read: activity masks, fluid velocities and gradients at faces, the cell
+    fields theta_p, mean parcel velocity, damping rate and width (the push reads theta_p and width for its
+    walls and packing cap). Built once per particle step by ``grid_fields``."""
+
+    cell_mask: np.ndarray
+    xface_mask: np.ndarray
+    zface_mask: np.ndarray
+    fluid_u: np.ndarray
+    fluid_v: np.ndarray
+    dpdx: np.ndarray
+    dpdz: np.ndarray
+    dtaudx: np.ndarray
+    dtaudz: np.ndarray
+    volume_fraction: np.ndarray
+    mean_u: np.ndarray
+    mean_v: np.ndarray
+    damping_rate: np.ndarray
+    width: np.ndarray
+
+
+@dataclass(frozen=True)
+class ParcelFluid:
+    """What a parcel sees (1-D arrays over parcels): fluid velocity u_f, v_f (Eq. 40), dynamic pressure
+    gradient (Eq. 41) and particle-stress gradient [Pa/m] (face gradients, same weights), theta_p, mean parcel
+    velocity and collision damping rate 1/tau_D (cell weights), and the width of the parcel's own cell [m]."""
+
+    fluid_u: np.ndarray
+    fluid_v: np.ndarray
+    dpdx: np.ndarray
+    dpdz: np.ndarray
+    dtaudx: np.ndarray
+    dtaudz: np.ndarray
+    volume_fraction: np.ndarray
+    mean_u: np.ndarray
+    mean_v: np.ndarray
+    damping_rate: np.ndarray
+    width: np.ndarray
+
+
+def check_width(width: np.ndarray) -> tuple[int, int]:
+    """(nz, nx) of a valid width field; ValueError naming the problem otherwise."""
+    if width.ndim != 2 or min(width.shape) < 1:
+        raise ValueError(f"width: shape {width.shape}; allowed: a 2-D (nz, nx) array with nz, nx >= 1")
+    if not np.all(np.isfinite(width)) or np.any(width < 0.0):
+        raise ValueError("width: has negative or non-finite values; allowed: finite values >= 0")
+    return width.shape
+
+
+def check_fluid(width: np.ndarray, u: np.ndarray, v: np.ndarray, pressure: np.ndarray) -> None:
+    """Shapes of the fluid fields against the width field (shared layout); ValueError naming the field."""
+    nz, nx = check_width(width)
+    for name, arr, shape in (("u", u, (nz, nx + 1)), ("v", v, (nz + 1, nx)), ("pressure", pressure, (nz, nx))):
+        if arr.shape != shape:
+            raise ValueError(f"{name}: shape {arr.shape}; allowed: {shape} for width of shape {(nz, nx)}")
+
+
+def moment_sums(parcels: Parcels, frame: GridFrame, width: np.ndarray) -> np.ndarray:
+    """Bilinear sums (7, nz, nx) of the MOMENT_CHANNELS over parcels (numerators of Eq. 38 and of the
+    mass averages of O'Rourke & Snider 2010)."""
+    shape = check_width(width)
+    cell_mask, _, _ = active_nodes(width)
+    k, i, w = weights(parcels.x, parcels.z, frame, "cell", cell_mask)
+    vol = parcels.solid_volume()
+    mass = vol * parcels.density
+    values = (vol, mass, mass * parcels.u, mass * parcels.v, mass * (parcels.u ** 2 + parcels.v ** 2),
+              parcels.particles * parcels.radius ** 3, parcels.particles * parcels.radius ** 2)
+    return np.stack([deposit(val, k, i, w, shape) for val in values])
+
+
+def finish_moments(sums: np.ndarray, frame: GridFrame, width: np.ndarray) -> CellMoments:
+    """CellMoments from the channel sums: theta_p by Eq. 38 (V = dx dz w), mass averages and Sauter radius."""
+    vol, mass, mu, mv, ms2, nr3, nr2 = sums
+    cell_volume = frame.dx * frame.dz * width
+
+    def ratio(a, b):
+        return np.divide(a, b, out=np.zeros_like(a), where=b > 0.0)
+
+    mean_u = ratio(mu, mass)
+    mean_v = ratio(mv, mass)
+    return CellMoments(volume_fraction=ratio(vol, cell_volume), solid_volume=np.ascontiguousarray(vol),
+                       mass=np.ascontiguousarray(mass),
+                       mean_u=mean_u, mean_v=mean_v,
+                       velocity_variance=np.maximum(ratio(ms2, mass) - mean_u ** 2 - mean_v ** 2, 0.0),
+                       sauter_radius=ratio(nr3, nr2))
+
+
+def grid_fields(frame: GridFrame, width: np.ndarray, u: np.ndarray, v: np.ndarray, pressure: np.ndarray,
+                moments: CellMoments, params: MppicParams) -> GridFields:
+    """Node fields for the gather: pressure and stress (Eq. 16) gradients differenced to active faces
+    (0 elsewhere), and the damping rate 1/tau_D per cell (O'Rourke & Snider 2010 eq. 48)."""
+    check_fluid(width, u, v, pressure)
+    cell, xmask, zmask = active_nodes(width)
+    tau = closures.particle_stress(moments.volume_fraction, params)
+
+    def grad_x(f):
+        g = np.zeros_like(xmask)
+        g[:, 1:-1] = (f[:, 1:] - f[:, :-1]) / frame.dx
+        return g * xmask
+
+    def grad_z(f):
+        g = np.zeros_like(zmask)
+        g[1:-1, :] = (f[1:, :] - f[:-1, :]) / frame.dz
+        return g * zmask
+
+    damping = closures.damping_rate(moments.volume_fraction, moments.velocity_variance,
+                                    moments.sauter_radius, params)
+    return GridFields(cell_mask=cell, xface_mask=xmask, zface_mask=zmask,
+                      fluid_u=np.ascontiguousarray(u, dtype=np.float64),
+                      fluid_v=np.ascontiguousarray(v, dtype=np.float64),
+                      dpdx=grad_x(pressure), dpdz=grad_z(pressure), dtaudx=grad_x(tau), dtaudz=grad_z(tau),
+                      volume_fraction=moments.volume_fraction, mean_u=moments.mean_u, mean_v=moments.mean_v,
+                      damping_rate=damping * cell, width=np.ascontiguousarray(width, dtype=np.float64))
+
+
+def gather(parcels: Parcels, frame: GridFrame, fields: GridFields) -> ParcelFluid:
+    """Grid fields at the parcels: face fields with x-/z-face weights (Eq. 40-41), cell fields with cell
+    weights, width of the own cell (0 outside the grid)."""
+    kc, ic, wc = weights(parcels.x, parcels.z, frame, "cell", fields.cell_mask)
+    kx, ix, wx = weights(parcels.x, parcels.z, frame, "xface", fields.xface_mask)
+    kz, iz, wz = weights(parcels.x, parcels.z, frame, "zface", fields.zface_mask)
+    ko, io, inside = owning_cell(parcels.x, parcels.z, frame, fields.width.shape)
+    return ParcelFluid(
+        fluid_u=interpolate(fields.fluid_u, kx, ix, wx), fluid_v=interpolate(fields.fluid_v, kz, iz, wz),
+        dpdx=interpolate(fields.dpdx, kx, ix, wx), dpdz=interpolate(fields.dpdz, kz, iz, wz),
+        dtaudx=interpolate(fields.dtaudx, kx, ix, wx), dtaudz=interpolate(fields.dtaudz, kz, iz, wz),
+        volume_fraction=interpolate(fields.volume_fraction, kc, ic, wc),
+        mean_u=interpolate(fields.mean_u, kc, ic, wc), mean_v=interpolate(fields.mean_v, kc, ic, wc),
+        damping_rate=interpolate(fields.damping_rate, kc, ic, wc),
+        width=np.where(inside, fields.width[ko, io], 0.0))
+
+
+def _limited_stress_velocity(delta, slip, grad, restitution):
+    """Snider (2001) eqs. 39-41 as in MFIX integrate_time_pic.f90: the stress velocity correction delta is
+    limited by (1 + e) x (mean parcel velocity - parcel velocity) and may only act along -grad tau."""
+    bound = (1.0 + restitution) * slip
+    return np.where(grad <= 0.0, np.maximum(np.minimum(delta, bound), 0.0),
+                    np.minimum(np.maximum(delta, bound), 0.0))
+
+
+def _blocked(x, z, x_try, z_try, frame: GridFrame, fields: GridFields, params: MppicParams) -> np.ndarray:
+    """True where the move (x, z) -> (x_try, z_try) leaves the grid, enters a closed cell, or raises the
+    bilinear weight (Eq. 37) of the parcel on a cell whose theta_p (Eq. 38, this step's scatter) is already
+    >= theta_cp (the packing cap of push)."""
+    k, i, inside = owning_cell(x_try, z_try, frame, fields.width.shape)
+    k0, i0, w0 = weights(x, z, frame, "cell", fields.cell_mask)
+    k1, i1, w1 = weights(x_try, z_try, frame, "cell", fields.cell_mask)
+    same = (k1[:, :, None] == k0[:, None, :]) & (i1[:, :, None] == i0[:, None, :])
+    before = np.sum(w0[:, None, :] * same, axis=2)
+    packed = fields.volume_fraction[k1, i1] >= params.theta_cp
+    return ~inside | (fields.width[k, i] <= 0.0) | np.any(packed & (w1 > before), axis=1)
+
+
+def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFields, dt: float,
+         params: MppicParams, fluid_density: float, fluid_viscosity: float, gravity: float) -> np.ndarray:
+    """Advance parcel velocities (Eq. 43) and positions (Eq. 44) in place; returns D_p per parcel [1/s].
+
+    Velocity: u~ = (u^o + dt (D u_f - grad p / rho_p + (1 - rho_f/rho_p) g + <u>/(2 tau_D))) /
+    (1 + dt (D + 1/(2 tau_D))), drag D(|u_f - u|) iterated ``drag_iterations`` times starting from u^o (the
+    returned D is the one of the last solve). Then the stress term -dt grad tau / (theta_p rho_p (1 + ...)),
+    limited per component by Snider (2001) eqs. 39-41 (packing limiter, see _limited_stress_velocity).
+    Walls, per component (x first): a move that would leave the grid, enter a closed cell, or raise the
+    parcel's bilinear weight on a cell whose theta_p (this step's scatter) is already >= theta_cp is cancelled
+    and that velocity component set to 0 (inelastic stop). The last rule is our packing cap: Snider's limiter
+    bounds the velocity relative to the cell's mean parcel velocity, which does not stop a stream of parcels
+    that arrives together against a wall; the cap bounds every cell's theta_p by theta_cp plus one step's
+    inflow, whatever the parcels' velocities.
+    Bridging: where the width of the parcel's cell is below bridging_factor x 2 r the parcel is set to state 1
+    with zero velocity and does not move; others get state 0. Gravity [m/s^2] acts along +z (depth).
+    """
+    rho_p = parcels.density
+    theta = seen.volume_fraction
+    half_rate = 0.5 * seen.damping_rate
+    buoyant_g = (1.0 - fluid_density / rho_p) * gravity
+    u_new, v_new = parcels.u, parcels.v
+    for _ in range(params.drag_iterations):
+        slip = np.hypot(seen.fluid_u - u_new, seen.fluid_v - v_new)
+        drag = closures.drag_rate(slip, parcels.radius, rho_p, theta, fluid_density, fluid_viscosity, params)
+        den = 1.0 + dt * (drag + half_rate)
+        u_new = (parcels.u + dt * (drag * seen.fluid_u - seen.dpdx / rho_p + half_rate * seen.mean_u)) / den
+        v_new = (parcels.v + dt * (drag * seen.fluid_v - seen.dpdz / rho_p + buoyant_g
+                                   + half_rate * seen.mean_v)) / den
+    scale = -dt / (np.maximum(theta, params.epsilon) * rho_p * den)
+    u_new = u_new + _limited_stress_velocity(scale * seen.dtaudx, seen.mean_u - u_new, seen.dtaudx,
+                                             params.packing_restitution)
+    v_new = v_new + _limited_stress_velocity(scale * seen.dtaudz, seen.mean_v - v_new, seen.dtaudz,
+                                             params.packing_restitution)
+    bridged = seen.width < params.bridging_factor * 2.0 * parcels.radius
+    u_new = np.where(bridged, 0.0, u_new)
+    v_new = np.where(bridged, 0.0, v_new)
+    x_try = parcels.x + dt * u_new
+    blocked = _blocked(parcels.x, parcels.z, x_try, parcels.z, frame, fields, params)
+    x_new = np.where(blocked, parcels.x, x_try)
+    u_new = np.where(blocked, 0.0, u_new)
+    z_try = parcels.z + dt * v_new
+    blocked = _blocked(x_new, parcels.z, x_new, z_try, frame, fields, params)
+    z_new = np.where(blocked, parcels.z, z_try)
+    v_new = np.where(blocked, 0.0, v_new)
+    parcels.x[:] = x_new
+    parcels.z[:] = z_new
+    parcels.u[:] = u_new
+    parcels.v[:] = v_new
+    parcels.state[:] = np.where(bridged, BRIDGED, SUSPENDED)
+    return drag
+
+
+def exchange(parcels: Parcels, seen: ParcelFluid, drag: np.ndarray, frame: GridFrame,
+             width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Interphase momentum transfer per unit volume at active faces, F_x (nz, nx+1), F_z (nz+1, nx) [N/m^3]
+    (Eq. 39): sum n rho_p V_p [D (u_f - u_p) - grad p / rho_p] I / V_face, V_face = dx dz w_face; it is the
+    force of the fluid on the particles (the fluid gets -F, Eq. 26). Uses the parcels' current positions and
+    velocities (after ``push``: u^{n+1}, the implicit drag velocity) and the D returned by ``push``."""
+    check_width(width)
+    _, xmask, zmask = active_nodes(width)
+    wxf, wzf = face_widths(width)
+    vol = parcels.solid_volume()
+    mass = vol * parcels.density
+    fx = mass * drag * (seen.fluid_u - parcels.u) - vol * seen.dpdx
+    fz = mass * drag * (seen.fluid_v - parcels.v) - vol * seen.dpdz
+    k, i, w = weights(parcels.x, parcels.z, frame, "xface", xmask)
+    sx = deposit(fx, k, i, w, xmask.shape)
+    k, i, w = weights(parcels.x, parcels.z, frame, "zface", zmask)
+    sz = deposit(fz, k, i, w, zmask.shape)
+    return per_face_volume(sx, frame, wxf), per_face_volume(sz, frame, wzf)
+
+
+def per_face_volume(sums: np.ndarray, frame: GridFrame, face_width: np.ndarray) -> np.ndarray:
+    """Face sums divided by V_face = dx dz w_face (Eq. 39; 0 at inactive faces)."""
+    volume = frame.dx * frame.dz * face_width
+    return np.divide(sums, volume, out=np.zeros_like(sums), where=face_width > 0.0)

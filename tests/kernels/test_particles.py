@@ -1,0 +1,271 @@
+"""Taichi particle kernels (CPU backend) against the NumPy reference, and invariants of the particle ops:
+conservation of scattered volume, equal and opposite exchange, exactness of interpolation, rest states,
+the drag law's terminal velocity, walls and bridging."""
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from hfgpu.proppant import closures
+from hfgpu.proppant.backend import get_backend, grid_fields
+from hfgpu.proppant.interpolation import active_nodes, face_widths, interpolate, weights
+from hfgpu.proppant.params import MppicParams
+from hfgpu.proppant.parcels import Parcels
+from hfgpu.records import GridFrame
+
+RTOL = 1e-12
+RHO_F, MU, G = 1000.0, 1e-3, 9.81
+
+
+@pytest.fixture(scope="module")
+def taichi_backend():
+    return get_backend("taichi", arch="cpu")
+
+
+@pytest.fixture(scope="module")
+def numpy_backend():
+    return get_backend("numpy")
+
+
+def random_case(seed=0, n=3000, nz=12, nx=17):
+    """Random grid with closed cells (a block and the first column) and parcels everywhere in open cells,
+    many of them within a fraction of a cell from walls and closed cells."""
+    rng = np.random.default_rng(seed)
+    frame = GridFrame(dx=0.01, dz=0.02, x0=0.005, z0=0.01)
+    width = rng.uniform(1e-3, 3e-3, (nz, nx))
+    width[4:7, 6:10] = 0.0
+    width[:, 0] = 0.0
+    xs = rng.uniform(frame.x0 - frame.dx / 2, frame.x0 + (nx - 0.5) * frame.dx, 4 * n)
+    zs = rng.uniform(frame.z0 - frame.dz / 2, frame.z0 + (nz - 0.5) * frame.dz, 4 * n)
+    i = np.floor((xs - frame.x0) / frame.dx + 0.5).astype(int)
+    k = np.floor((zs - frame.z0) / frame.dz + 0.5).astype(int)
+    keep = np.flatnonzero(width[k, i] > 0)[:n]
+    parcels = Parcels.create(xs[keep], zs[keep], radius=rng.uniform(1e-4, 3e-4, n),
+                             density=rng.uniform(2500, 2700, n), particles=rng.uniform(5, 50, n),
+                             u=rng.normal(0, 0.02, n), v=rng.normal(0, 0.02, n))
+    fluid = dict(u=rng.normal(0, 0.05, (nz, nx + 1)), v=rng.normal(0, 0.05, (nz + 1, nx)),
+                 pressure=rng.normal(0, 20.0, (nz, nx)))
+    return frame, width, parcels, fluid
+
+
+def close(a, b, rtol=RTOL):
+    """Equal to rtol relative to the largest magnitude of the reference array."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    scale = max(np.max(np.abs(b)), 1e-300)
+    np.testing.assert_allclose(a, b, rtol=0, atol=rtol * scale)
+
+
+def run_step(backend, frame, width, parcels, fluid, params, dt=2e-3):
+    moments = backend.scatter(parcels, frame, width)
+    fields = grid_fields(frame, width, fluid["u"], fluid["v"], fluid["pressure"], moments, params)
+    seen = backend.gather(parcels, frame, fields)
+    drag = backend.push(parcels, seen, frame, fields, dt, params, RHO_F, MU, G)
+    forces = backend.exchange(parcels, seen, drag, frame, width)
+    return moments, seen, drag, forces
+
+
+@pytest.mark.parametrize("drag_law, sort, theta_cp", [("wen-yu", False, 0.6), ("snider", False, 0.6),
+                                                      ("wen-yu", True, 0.6), ("wen-yu", True, 0.045)])
+def test_taichi_matches_numpy(taichi_backend, numpy_backend, drag_law, sort, theta_cp):
+    """Random order (every parcel flushes its own deposit) and sorted by cell (runs summed locally); with
+    theta_cp = 0.045 about half of the cells count as packed, so the packing cap of the push acts."""
+    frame, width, parcels, fluid = random_case()
+    if sort:
+        parcels.sort_by_cell(frame, width.shape)
+    params = MppicParams(drag_law=drag_law, P_s=100.0, damping_threshold=0.0, theta_cp=theta_cp)
+    a, b = parcels.copy(), parcels.copy()
+    ra = run_step(taichi_backend, frame, width, a, fluid, params)
+    rb = run_step(numpy_backend, frame, width, b, fluid, params)
+    for name in ra[0].__dataclass_fields__:
+        close(getattr(ra[0], name), getattr(rb[0], name))
+    for name in ra[1].__dataclass_fields__:
+        close(getattr(ra[1], name), getattr(rb[1], name))
+    close(ra[2], rb[2])
+    for fa, fb in zip(ra[3], rb[3]):
+        close(fa, fb)
+    for name in ("x", "z", "u", "v"):
+        close(getattr(a, name), getattr(b, name))
+    np.testing.assert_array_equal(a.state, b.state)
+
+
+@pytest.mark.parametrize("backend_name", ["numpy", "taichi"])
+def test_scattered_volume_is_parcel_volume(backend_name, taichi_backend, numpy_backend):
+    """Eq. 38 x cell volume summed over cells == sum of parcel solid volumes, with parcels touching the
+    domain edges and closed cells (weights onto them are renormalised)."""
+    backend = taichi_backend if backend_name == "taichi" else numpy_backend
+    frame, width, parcels, _ = random_case(seed=1)
+    moments = backend.scatter(parcels, frame, width)
+    deposited = np.sum(moments.volume_fraction * frame.dx * frame.dz * width)
+    assert deposited == pytest.approx(parcels.solid_volume().sum(), rel=1e-12)
+    assert np.all(moments.volume_fraction[width == 0] == 0)
+    assert np.sum(moments.mass) == pytest.approx(np.sum(parcels.solid_volume() * parcels.density), rel=1e-12)
+
+
+def test_sorting_changes_no_result(taichi_backend):
+    frame, width, parcels, fluid = random_case(seed=5)
+    params = MppicParams()
+    ordered = parcels.copy()
+    ordered.sort_by_cell(frame, width.shape)
+    assert not np.array_equal(np.lexsort((parcels.x, parcels.z)), np.arange(parcels.n))
+    ra = run_step(taichi_backend, frame, width, parcels, fluid, params)
+    rb = run_step(taichi_backend, frame, width, ordered, fluid, params)
+    for name in ra[0].__dataclass_fields__:
+        close(getattr(rb[0], name), getattr(ra[0], name))
+    for fa, fb in zip(ra[3], rb[3]):
+        close(fb, fa)
+    close(np.sort(ordered.x), np.sort(parcels.x))
+    close(np.sort(ordered.v), np.sort(parcels.v))
+
+
+@pytest.mark.parametrize("backend_name", ["numpy", "taichi"])
+def test_exchange_is_equal_and_opposite(backend_name, taichi_backend, numpy_backend):
+    """sum F V_face == sum over parcels n rho_p V_p [D (u_f - u_p) - grad p / rho_p] (Eq. 39)."""
+    backend = taichi_backend if backend_name == "taichi" else numpy_backend
+    frame, width, parcels, fluid = random_case(seed=2)
+    params = MppicParams()
+    _, seen, drag, (fx, fz) = run_step(backend, frame, width, parcels, fluid, params)
+    wxf, wzf = face_widths(width)
+    vol = parcels.solid_volume()
+    mass = vol * parcels.density
+    per_x = mass * drag * (seen.fluid_u - parcels.u) - vol * seen.dpdx
+    per_z = mass * drag * (seen.fluid_v - parcels.v) - vol * seen.dpdz
+    _, xmask, zmask = active_nodes(width)
+    has_x = weights(parcels.x, parcels.z, frame, "xface", xmask)[2].sum(axis=1) > 0
+    has_z = weights(parcels.x, parcels.z, frame, "zface", zmask)[2].sum(axis=1) > 0
+    assert np.sum(fx * frame.dx * frame.dz * wxf) == pytest.approx(per_x[has_x].sum(), rel=1e-11)
+    assert np.sum(fz * frame.dx * frame.dz * wzf) == pytest.approx(per_z[has_z].sum(), rel=1e-11)
+    assert has_x.mean() > 0.95 and has_z.mean() > 0.95
+
+
+@pytest.mark.parametrize("location", ["cell", "xface", "zface"])
+def test_interpolation_of_linear_field_is_exact(location):
+    """Bilinear weights (Eq. 36-37) reproduce a linear field wherever the 2 x 2 stencil is active."""
+    nz, nx = 8, 11
+    frame = GridFrame(dx=0.3, dz=0.2, x0=1.0, z0=-0.5)
+    masks = dict(zip(("cell", "xface", "zface"), active_nodes(np.ones((nz, nx)))))
+    mask = masks[location]
+    ox, oz = {"cell": (0, 0), "xface": (-0.5, 0), "zface": (0, -0.5)}[location]
+    kk, ii = np.meshgrid(np.arange(mask.shape[0]), np.arange(mask.shape[1]), indexing="ij")
+    field = 3.0 + 2.0 * (frame.x0 + (ii + ox) * frame.dx) - 5.0 * (frame.z0 + (kk + oz) * frame.dz)
+    rng = np.random.default_rng(3)
+    # points whose whole stencil lies on active nodes: 1 cell away from the edges
+    x = rng.uniform(frame.x0 + frame.dx, frame.x0 + (nx - 2) * frame.dx, 500)
+    z = rng.uniform(frame.z0 + frame.dz, frame.z0 + (nz - 2) * frame.dz, 500)
+    k, i, w = weights(x, z, frame, location, mask)
+    np.testing.assert_allclose(interpolate(field, k, i, w), 3.0 + 2.0 * x - 5.0 * z, rtol=1e-13)
+
+
+def test_weights_drop_closed_and_outside_nodes():
+    width = np.ones((3, 3))
+    width[1, 2] = 0.0
+    frame = GridFrame(1.0, 1.0, 0.0, 0.0)
+    k, i, w = weights(np.array([1.3, -0.4]), np.array([1.2, 2.4]), frame, "cell", active_nodes(width)[0])
+    np.testing.assert_allclose(w.sum(axis=1), 1.0, rtol=1e-15)
+    assert np.all(w[0][(k[0] == 1) & (i[0] == 2)] == 0)
+    assert w[1].max() == 1.0  # the corner point sits in cell (2, 0) only
+
+
+@pytest.mark.parametrize("backend_name", ["numpy", "taichi"])
+def test_parcel_at_rest_in_still_fluid_without_gravity_stays(backend_name, taichi_backend, numpy_backend):
+    backend = taichi_backend if backend_name == "taichi" else numpy_backend
+    nz, nx = 6, 6
+    frame = GridFrame(0.01, 0.01, 0.005, 0.005)
+    width = np.full((nz, nx), 2e-3)
+    parcels = Parcels.create(np.array([0.0231, 0.04]), np.array([0.0317, 0.011]), radius=2e-4,
+                             density=2650.0, particles=10.0)
+    before = parcels.copy()
+    still = dict(u=np.zeros((nz, nx + 1)), v=np.zeros((nz + 1, nx)), pressure=np.zeros((nz, nx)))
+    for _ in range(20):
+        moments = backend.scatter(parcels, frame, width)
+        fields = grid_fields(frame, width, still["u"], still["v"], still["pressure"], moments, MppicParams())
+        seen = backend.gather(parcels, frame, fields)
+        backend.push(parcels, seen, frame, fields, 1e-3, MppicParams(), RHO_F, MU, 0.0)
+    for name in ("x", "z", "u", "v"):
+        np.testing.assert_array_equal(getattr(parcels, name), getattr(before, name))
+
+
+@pytest.mark.parametrize("backend_name, drag_law, published", [("numpy", "wen-yu", 0.0669),
+                                                                ("taichi", "wen-yu", 0.0669),
+                                                                ("taichi", "snider", 0.0659)])
+def test_single_parcel_reaches_terminal_velocity(backend_name, drag_law, published, taichi_backend,
+                                                 numpy_backend):
+    """Still fluid: the implicit push converges to D_p(v) v = (1 - rho_f/rho_p) g, the analytic fixed point;
+    at theta_p -> 0 that is the terminal velocity of REFERENCE.md 7 (d = 0.45 mm in water: Schiller-Naumann
+    0.0669 m/s, Snider C_d 0.0659 m/s)."""
+    backend = taichi_backend if backend_name == "taichi" else numpy_backend
+    nz, nx = 4, 3
+    frame = GridFrame(dx=1.0, dz=1.0, x0=0.5, z0=0.5)
+    width = np.full((nz, nx), 1.0)
+    r, rho_p = 0.225e-3, 2550.0
+    parcels = Parcels.create(np.array([1.5]), np.array([0.7]), radius=r, density=rho_p, particles=1.0)
+    params = MppicParams(drag_iterations=4, drag_law=drag_law)
+    still = dict(u=np.zeros((nz, nx + 1)), v=np.zeros((nz + 1, nx)), pressure=np.zeros((nz, nx)))
+    for _ in range(400):
+        moments = backend.scatter(parcels, frame, width)
+        fields = grid_fields(frame, width, still["u"], still["v"], still["pressure"], moments, params)
+        seen = backend.gather(parcels, frame, fields)
+        backend.push(parcels, seen, frame, fields, 1e-3, params, RHO_F, MU, G)
+    theta = seen.volume_fraction[0]
+    g_eff = (1 - RHO_F / rho_p) * G
+    exact = brentq(lambda vt: closures.drag_rate(vt, r, rho_p, theta, RHO_F, MU, params) * vt - g_eff,
+                   1e-6, 1.0, xtol=1e-15)
+    assert parcels.v[0] == pytest.approx(exact, rel=1e-9)
+    assert parcels.u[0] == 0.0
+    assert parcels.v[0] == pytest.approx(published, rel=2e-3)
+
+
+@pytest.mark.parametrize("backend_name", ["numpy", "taichi"])
+def test_walls_and_closed_cells_stop_parcels(backend_name, taichi_backend, numpy_backend):
+    backend = taichi_backend if backend_name == "taichi" else numpy_backend
+    nz, nx = 4, 4
+    frame = GridFrame(0.01, 0.01, 0.005, 0.005)
+    width = np.full((nz, nx), 2e-3)
+    width[1, 2] = 0.0
+    # one parcel heading right into the closed cell (1, 2); one heading down out of the grid
+    parcels = Parcels.create(np.array([0.0195, 0.025]), np.array([0.015, 0.0395]), radius=1e-4,
+                             density=2650.0, particles=1.0, u=np.array([1.0, 0.0]), v=np.array([0.0, 1.0]))
+    flow = dict(u=np.full((nz, nx + 1), 1.0), v=np.full((nz + 1, nx), 1.0), pressure=np.zeros((nz, nx)))
+    params = MppicParams()
+    for _ in range(5):
+        moments = backend.scatter(parcels, frame, width)
+        fields = grid_fields(frame, width, flow["u"], flow["v"], flow["pressure"], moments, params)
+        seen = backend.gather(parcels, frame, fields)
+        backend.push(parcels, seen, frame, fields, 1e-3, params, RHO_F, MU, 0.0)
+    assert parcels.x[0] < 0.02 and parcels.u[0] == 0.0
+    assert parcels.z[1] < 0.04 and parcels.v[1] == 0.0
+
+
+@pytest.mark.parametrize("backend_name", ["numpy", "taichi"])
+def test_bridging_stops_and_releases(backend_name, taichi_backend, numpy_backend):
+    backend = taichi_backend if backend_name == "taichi" else numpy_backend
+    nz, nx = 3, 3
+    frame = GridFrame(0.01, 0.01, 0.005, 0.005)
+    r = 2e-4
+    params = MppicParams(bridging_factor=2.0)
+    parcels = Parcels.create(np.array([0.015]), np.array([0.015]), radius=r, density=2650.0, particles=1.0,
+                             u=0.1, v=0.1)
+    flow = dict(u=np.full((nz, nx + 1), 0.1), v=np.zeros((nz + 1, nx)), pressure=np.zeros((nz, nx)))
+
+    def step(width):
+        moments = backend.scatter(parcels, frame, width)
+        fields = grid_fields(frame, width, flow["u"], flow["v"], flow["pressure"], moments, params)
+        backend.push(parcels, backend.gather(parcels, frame, fields), frame, fields, 1e-3, params, RHO_F, MU, G)
+
+    narrow = np.full((nz, nx), 2e-3)
+    narrow[1, 1] = 0.9 * 2 * params.bridging_factor * r
+    x0 = parcels.x.copy()
+    for _ in range(3):
+        step(narrow)
+        assert parcels.state[0] == 1 and parcels.u[0] == 0.0 and parcels.v[0] == 0.0
+    assert parcels.x[0] == x0[0]
+    step(np.full((nz, nx), 2e-3))
+    assert parcels.state[0] == 0 and parcels.x[0] > x0[0]
+
+
+def test_bad_fluid_shapes_are_named():
+    frame, width, parcels, fluid = random_case(n=10)
+    moments = get_backend("numpy").scatter(parcels, frame, width)
+    with pytest.raises(ValueError, match="v: shape"):
+        grid_fields(frame, width, fluid["u"], fluid["v"][:-1], fluid["pressure"], moments, MppicParams())
+    with pytest.raises(ValueError, match="mppic.backend"):
+        get_backend("cuda-python")
