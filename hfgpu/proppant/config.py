@@ -1,0 +1,327 @@
+"""The proppant part of a scene: ``[geometry]``, ``[[proppant]]`` and ``[mppic]``, parsed into a frozen
+:class:`ProppantSetup` before any work starts.
+
+Coordinates: x along the slot/fracture length, depth z positive downward, both in metres. For "box" and "slot"
+the domain is [0, length] x [0, height] (depth 0 at the top); for "field" the grid is the one of the width file.
+
+``[geometry]``
+    ``kind = "box"`` (closed vessel, e.g. a settling column) | ``"slot"`` (uniform gap with inlets and
+    outlets, e.g. Chun et al. 2020) | ``"field"`` (width map from a file). ``length, height, width`` (box,
+    slot). ``file`` (field): ``.npz`` or ``.h5`` holding 1-D ``x`` (nx) and ``z`` (nz) cell-centre
+    coordinates on a uniform grid [m] and ``w`` (nz, nx) [m], 0 = closed cell; a relative path is taken from
+    the working directory. ``[[geometry.inlets]]`` and ``[[geometry.outlets]]``: ports (see :class:`Port`).
+``[[proppant]]``
+    ``name, density``, either ``diameter = "198 um"`` or ``size = "40/70"`` (sieve class, see
+    :mod:`hfgpu.proppant.sieve`), ``distribution = "fixed" | "uniform" | "normal"`` (default fixed for a
+    diameter, normal for a sieve class), ``mean_diameter``, ``std``, ``initial_volume_fraction`` (uniform
+    suspension over the open domain at t = 0, default 0).
+``[mppic]``
+    numerics (:class:`MppicNumerics`) and every field of :class:`hfgpu.proppant.params.MppicParams` under its
+    own name (closure constants).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import SceneError
+from ..scene_reader import Table
+from .sieve import DISTRIBUTIONS, SizeDistribution, make_distribution, sieve_range
+
+GEOMETRY_KINDS = ("box", "slot", "field")
+PORT_KINDS = ("point", "segment", "annulus")
+BACKENDS = ("taichi", "numpy")
+
+
+@dataclass(frozen=True)
+class Port:
+    """An inlet or outlet region in the (x, depth) plane.
+
+    kind "point": the cell holding (x, depth); "segment": the cells crossed by the segment (x, depth) ->
+    (x_end, depth_end); "annulus": the cells whose centres lie at a distance in [inner_radius, outer_radius]
+    from (x, depth) (the cells around a perforation). ``share`` weights an inlet's part of the slurry rate
+    (shares are normalised over the inlets).
+    """
+
+    kind: str
+    x: float
+    depth: float
+    x_end: float = 0.0
+    depth_end: float = 0.0
+    inner_radius: float = 0.0
+    outer_radius: float = 0.0
+    share: float = 1.0
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """The proppant domain: a uniform gap (box, slot) or a width map (field)."""
+
+    kind: str
+    length: float
+    height: float
+    width: float | None = None
+    file: str | None = None
+    field_x: np.ndarray | None = field(default=None, repr=False, compare=False)
+    field_z: np.ndarray | None = field(default=None, repr=False, compare=False)
+    field_w: np.ndarray | None = field(default=None, repr=False, compare=False)
+    inlets: tuple[Port, ...] = ()
+    outlets: tuple[Port, ...] = ()
+
+
+@dataclass(frozen=True)
+class ProppantClass:
+    """One proppant: name, particle density [kg/m^3], size distribution, initial suspension fraction."""
+
+    name: str
+    density: float
+    size: SizeDistribution
+    initial_volume_fraction: float = 0.0
+    sieve: str | None = None
+
+
+@dataclass(frozen=True)
+class MppicNumerics:
+    """Numerical knobs of the MP-PIC run loop.
+
+    backend/arch: particle and momentum kernels ("taichi" default, "numpy" reference); arch as
+    hfgpu.kernels.runtime (None: HFGPU_ARCH or cpu).
+    particles_per_parcel: real particles per parcel for every class; when None, it is chosen per class so
+    that ``parcels_per_cell`` parcels fill a cell at the class's largest volume fraction (initial or
+    injected).
+    particle_substeps: particle sub-steps inside each fluid step (section 4.3).
+    c_max: Courant limit of Eq. 42 (< 1); dt_max caps the fluid step [s]; max_step_retries: halvings of a
+    step whose Courant number came out above c_max before giving up.
+    simple_tolerance / simple_max_iterations: Algorithm 1 stopping rule (relative |p'|).
+    gravity [m/s^2] acts along +depth.
+    slurry_viscosity: the fluid phase uses the slurry viscosity of Eq. 10 (MppicParams.viscosity_law); false
+    uses the clean-fluid viscosity. Eq. 10 diverges at close packing, and the fluid step's explicit in-plane
+    diffusion is then unstable in a packed bed, so scenes that build a bed turn it off for now.
+    """
+
+    backend: str = "taichi"
+    arch: str | None = None
+    particles_per_parcel: float | None = None
+    parcels_per_cell: int = 16
+    particle_substeps: int = 4
+    c_max: float = 0.5
+    dt_max: float = 0.05
+    max_step_retries: int = 6
+    simple_tolerance: float = 1e-5
+    simple_max_iterations: int = 50
+    gravity: float = 9.81
+    slurry_viscosity: bool = True
+
+
+@dataclass(frozen=True)
+class ProppantSetup:
+    geometry: Geometry
+    classes: tuple[ProppantClass, ...]
+    numerics: MppicNumerics
+    params: Any  # hfgpu.proppant.params.MppicParams
+
+    def class_densities(self) -> dict[str, float]:
+        """{class name: particle density [kg/m^3]} (used to turn ppa concentrations into fractions)."""
+        return {c.name: c.density for c in self.classes}
+
+    def class_index(self, name: str) -> int:
+        return [c.name for c in self.classes].index(name)
+
+
+def parse_proppant_setup(top: Table, run: Any, fluid: Any, mesh: Any) -> ProppantSetup:
+    """Read ``[geometry]``, ``[[proppant]]`` and ``[mppic]`` from the scene's top table."""
+    geometry = _parse_geometry(top.table("geometry"))
+    classes = _parse_classes(top)
+    numerics, params = _parse_mppic(top.table("mppic", {}))
+    if geometry.kind == "field":
+        _check_field_spacing(geometry, mesh)
+    return ProppantSetup(geometry=geometry, classes=classes, numerics=numerics, params=params)
+
+
+# ----------------------------------------------------------------------------------------------
+# [geometry]
+
+
+def _parse_geometry(t: Table) -> Geometry:
+    kind = t.choice("kind", GEOMETRY_KINDS)
+    inlets = tuple(_parse_port(p, inlet=True) for p in t.tables("inlets"))
+    outlets = tuple(_parse_port(p, inlet=False) for p in t.tables("outlets"))
+    if kind == "field":
+        path = t.string("file")
+        x, z, w = _read_width_file(t.key_path("file"), path)
+        geometry = Geometry(kind=kind, length=float(x[-1] - x[0] + _spacing(x)),
+                            height=float(z[-1] - z[0] + _spacing(z)), file=path, field_x=x, field_z=z,
+                            field_w=w, inlets=inlets, outlets=outlets)
+    else:
+        positive = dict(minimum=0.0, exclusive_minimum=True)
+        geometry = Geometry(kind=kind, length=t.quantity("length", "length", **positive),
+                            height=t.quantity("height", "length", **positive),
+                            width=t.quantity("width", "length", **positive), inlets=inlets, outlets=outlets)
+    if kind == "slot" and (not inlets or not outlets):
+        raise SceneError(t.key_path("inlets" if not inlets else "outlets"), "(none)",
+                         'a "slot" needs at least one [[geometry.inlets]] and one [[geometry.outlets]]')
+    t.finish()
+    return geometry
+
+
+def _parse_port(t: Table, inlet: bool) -> Port:
+    kind = t.choice("kind", PORT_KINDS)
+    values: dict[str, Any] = dict(kind=kind, x=t.quantity("x", "length"), depth=t.quantity("depth", "length"))
+    if kind == "segment":
+        values.update(x_end=t.quantity("x_end", "length"), depth_end=t.quantity("depth_end", "length"))
+    if kind == "annulus":
+        values.update(inner_radius=t.quantity("inner_radius", "length", 0.0, minimum=0.0))
+        values.update(outer_radius=t.quantity("outer_radius", "length", minimum=values["inner_radius"],
+                                              exclusive_minimum=True))
+    if inlet:
+        values.update(share=t.number("share", 1.0, minimum=0.0, exclusive_minimum=True))
+    t.finish()
+    return Port(**values)
+
+
+def _read_width_file(path_key: str, path: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """x (nx), z (nz), w (nz, nx) from an .npz or .h5 width file, checked."""
+    file = Path(path)
+    if not file.is_file():
+        raise SceneError(path_key, path, "no such width file (.npz or .h5 with arrays x, z, w)")
+    try:
+        if file.suffix == ".npz":
+            with np.load(file) as data:
+                x, z, w = (np.asarray(data[k], dtype=float) for k in ("x", "z", "w"))
+        elif file.suffix in (".h5", ".hdf5"):
+            import h5py
+
+            with h5py.File(file, "r") as data:
+                x, z, w = (np.asarray(data[k][()], dtype=float) for k in ("x", "z", "w"))
+        else:
+            raise SceneError(path_key, path, "allowed width files: .npz, .h5, .hdf5")
+    except KeyError as exc:
+        raise SceneError(path_key, path, f"the width file lacks array {exc}; it needs x, z, w") from None
+    if x.ndim != 1 or z.ndim != 1 or w.shape != (z.size, x.size) or x.size < 2 or z.size < 2:
+        raise SceneError(path_key, path, f"expected x (nx >= 2), z (nz >= 2) and w (nz, nx); got shapes "
+                         f"{x.shape}, {z.shape}, {w.shape}")
+    for name, axis in (("x", x), ("z", z)):
+        steps = np.diff(axis)
+        if np.any(steps <= 0) or np.ptp(steps) > 1e-9 * abs(steps[0]):
+            raise SceneError(path_key, path, f"{name} must be uniformly spaced and increasing")
+    if not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise SceneError(path_key, path, "w must be finite and >= 0 (0 = closed cell)")
+    return x, z, w
+
+
+def _spacing(axis: np.ndarray) -> float:
+    return float(axis[1] - axis[0])
+
+
+def _check_field_spacing(geometry: Geometry, mesh: Any) -> None:
+    for name, axis, size in (("x", geometry.field_x, mesh.dx), ("z", geometry.field_z, mesh.dz)):
+        if abs(_spacing(axis) - size) > 1e-9 * size:
+            raise SceneError("mesh.cell_size", size, f"must equal the width file's {name} spacing "
+                             f"{_spacing(axis):g} m for a \"field\" geometry")
+
+
+# ----------------------------------------------------------------------------------------------
+# [[proppant]]
+
+
+def _parse_classes(top: Table) -> tuple[ProppantClass, ...]:
+    tables = top.tables("proppant")
+    if not tables:
+        raise SceneError("proppant", "(none)", "at least one [[proppant]] class is required")
+    classes = []
+    for t in tables:
+        name = t.string("name")
+        if name in [c.name for c in classes]:
+            raise SceneError(t.key_path("name"), name, "class names must be distinct")
+        classes.append(ProppantClass(
+            name=name,
+            density=t.quantity("density", "density", minimum=0.0, exclusive_minimum=True),
+            size=_parse_size(t),
+            initial_volume_fraction=t.number("initial_volume_fraction", 0.0, minimum=0.0, maximum=0.6),
+            sieve=t.data.get("size"),
+        ))
+        t.finish()
+    total = sum(c.initial_volume_fraction for c in classes)
+    if total > 0.6:
+        raise SceneError("proppant[*].initial_volume_fraction", total, "the classes' sum must be <= 0.6")
+    return tuple(classes)
+
+
+def _parse_size(t: Table) -> SizeDistribution:
+    if t.has("diameter") == t.has("size"):
+        raise SceneError(t.key_path("diameter"), t.data.get("diameter", t.data.get("size")),
+                         'give exactly one of diameter = "198 um" or size = "40/70" (sieve class)')
+    if t.has("diameter"):
+        d = t.quantity("diameter", "length", minimum=0.0, exclusive_minimum=True)
+        kind = t.choice("distribution", ("fixed",), "fixed")
+        return make_distribution(kind, d, d)
+    label = t.raw("size")
+    try:
+        d_min, d_max = sieve_range(str(label))
+    except ValueError as exc:
+        raise SceneError(t.key_path("size"), label, str(exc)) from None
+    kind = t.choice("distribution", DISTRIBUTIONS, "normal")
+    within = dict(minimum=d_min, maximum=d_max)
+    mean = t.quantity("mean_diameter", "length", None, **within)
+    std = t.quantity("std", "length", None, minimum=0.0, exclusive_minimum=True)
+    return make_distribution(kind, d_min, d_max, mean, std)
+
+
+# ----------------------------------------------------------------------------------------------
+# [mppic]
+
+
+def _parse_mppic(t: Table) -> tuple[MppicNumerics, Any]:
+    d = MppicNumerics()
+    positive = dict(minimum=0.0, exclusive_minimum=True)
+    backend = t.choice("backend", BACKENDS, d.backend)
+    arch = t.raw("arch", None)
+    if arch is not None:
+        arch = t.choice("arch", ("cpu", "gpu", "cuda", "vulkan", "metal"))
+    numerics = MppicNumerics(
+        backend=backend,
+        arch=arch,
+        particles_per_parcel=t.number("particles_per_parcel", None, minimum=1.0),
+        parcels_per_cell=t.integer("parcels_per_cell", d.parcels_per_cell, minimum=1),
+        particle_substeps=t.integer("particle_substeps", d.particle_substeps, minimum=1, maximum=1000),
+        c_max=t.number("c_max", d.c_max, maximum=1.0, exclusive_maximum=True, **positive),
+        dt_max=t.quantity("dt_max", "time", d.dt_max, **positive),
+        max_step_retries=t.integer("max_step_retries", d.max_step_retries, minimum=0, maximum=30),
+        simple_tolerance=t.number("simple_tolerance", d.simple_tolerance, maximum=0.1, **positive),
+        simple_max_iterations=t.integer("simple_max_iterations", d.simple_max_iterations, minimum=1),
+        gravity=t.quantity("gravity", "acceleration", d.gravity, minimum=0.0),
+        slurry_viscosity=t.boolean("slurry_viscosity", d.slurry_viscosity),
+    )
+    params = _parse_params(t)
+    t.finish()
+    return numerics, params
+
+
+def _parse_params(t: Table) -> Any:
+    """MppicParams from the keys named like its fields; each value checked against the default's type."""
+    from .params import MppicParams
+
+    values: dict[str, Any] = {}
+    for f in dataclasses.fields(MppicParams):
+        if not t.has(f.name):
+            continue
+        default = getattr(MppicParams(), f.name)
+        if isinstance(default, bool):
+            values[f.name] = t.boolean(f.name)
+        elif isinstance(default, int):
+            values[f.name] = t.integer(f.name, minimum=1)
+        elif isinstance(default, str):
+            values[f.name] = t.string(f.name)
+        else:
+            values[f.name] = t.number(f.name)
+    try:
+        return MppicParams(**values)
+    except SceneError:
+        raise
+    except (ValueError, TypeError) as exc:
+        raise SceneError(t.path or "mppic", values, f"invalid closure parameters: {exc}") from None

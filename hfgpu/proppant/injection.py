@@ -1,0 +1,201 @@
+"""Where parcels come from: the initial uniform suspension and the slurry inlets.
+
+A slurry rate Q at slurry volume fraction c carries fluid (1 - c) Q and solids c Q (the paper's Eq. 7 source
+Q(t) delta(x) is the fluid part here; the solids enter as parcels). Each inlet is a set of open cells (a
+:class:`hfgpu.proppant.config.Port` mapped onto the grid) receiving its share of the rate. Parcels are emitted
+with exactly the scheduled solid volume: an inlet keeps the solid volume not yet emitted and the diameter of the
+next parcel, and emits parcels of ``particles_per_parcel`` particles while that volume covers the next one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import SceneError
+from ..records import GridFrame
+from .config import Port, ProppantClass
+
+PARCEL_KEYS = ("x", "z", "u", "v", "radius", "density", "particles", "state", "class_id")
+
+
+def port_cells(port: Port, frame: GridFrame, width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(k, i) indices of the open cells a port covers (point: its cell; segment: the cells it crosses;
+    annulus: the cells whose centres lie within [inner_radius, outer_radius] of the centre)."""
+    nz, nx = width.shape
+    if port.kind == "annulus":
+        xc, zc = frame.centres(nz, nx)
+        r = np.hypot(xc[None, :] - port.x, zc[:, None] - port.depth)
+        k, i = np.nonzero((r >= port.inner_radius) & (r <= port.outer_radius))
+    else:
+        if port.kind == "point":
+            xs, zs = np.array([port.x]), np.array([port.depth])
+        else:
+            length = math.hypot(port.x_end - port.x, port.depth_end - port.depth)
+            s = np.linspace(0.0, 1.0, max(2, int(math.ceil(4 * length / min(frame.dx, frame.dz))) + 1))
+            xs, zs = port.x + s * (port.x_end - port.x), port.depth + s * (port.depth_end - port.depth)
+        i = np.clip(np.floor((xs - frame.x0) / frame.dx + 0.5).astype(int), 0, nx - 1)
+        k = np.clip(np.floor((zs - frame.z0) / frame.dz + 0.5).astype(int), 0, nz - 1)
+        k, i = np.unique(np.stack([k, i]), axis=1)
+    keep = width[k, i] > 0.0
+    return k[keep], i[keep]
+
+
+def ports_to_cells(ports: tuple[Port, ...], frame: GridFrame, width: np.ndarray, key: str) -> list:
+    """Cells of each port; a port that covers no open cell is a SceneError naming ``key[index]``."""
+    cells = []
+    for n, port in enumerate(ports):
+        k, i = port_cells(port, frame, width)
+        if k.size == 0:
+            raise SceneError(f"{key}[{n}]", port, "this port covers no open cell of the grid")
+        cells.append((k, i))
+    return cells
+
+
+def empty_batch() -> dict[str, np.ndarray]:
+    """A parcel batch (dict of 1-D arrays in the shared layout) with no parcels."""
+    return {k: np.zeros(0, dtype=np.int32 if k in ("state", "class_id") else float) for k in PARCEL_KEYS}
+
+
+def make_batch(x, z, diameters, density, particles, class_id) -> dict[str, np.ndarray]:
+    """Parcels at rest, suspended, of one class."""
+    n = len(x)
+    return dict(x=np.asarray(x, float), z=np.asarray(z, float), u=np.zeros(n), v=np.zeros(n),
+                radius=0.5 * np.asarray(diameters, float), density=np.full(n, float(density)),
+                particles=np.broadcast_to(np.asarray(particles, float), (n,)).copy(),
+                state=np.zeros(n, np.int32), class_id=np.full(n, class_id, np.int32))
+
+
+def concat_batches(batches: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    if not batches:
+        return empty_batch()
+    return {k: np.concatenate([b[k] for b in batches]) for k in PARCEL_KEYS}
+
+
+def batch_solid_volume(batch: dict[str, np.ndarray]) -> float:
+    """Sum of particles x 4/3 pi r^3 over a batch [m^3]."""
+    return float(np.sum(batch["particles"] * (4.0 / 3.0 * np.pi) * batch["radius"] ** 3))
+
+
+def uniform_points(rng: np.random.Generator, frame: GridFrame, k: np.ndarray, i: np.ndarray,
+                   cell: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points uniformly distributed in the cells ``(k[cell], i[cell])``."""
+    x = frame.x0 + (i[cell] + rng.random(cell.size) - 0.5) * frame.dx
+    z = frame.z0 + (k[cell] + rng.random(cell.size) - 0.5) * frame.dz
+    return x, z
+
+
+def initial_suspension(classes: tuple[ProppantClass, ...], frame: GridFrame, width: np.ndarray,
+                       particles_per_parcel: list[float], rng: np.random.Generator) -> dict[str, np.ndarray]:
+    """Uniform suspension at t = 0: every open cell holds exactly theta_0 x V_cell of each class.
+
+    Each cell gets m = round(theta_0 V_cell / (particles_per_parcel E[V_p])) parcels (at least one), at
+    uniform random x and depths stratified in m equal slices of the cell (less sampling noise in theta_p);
+    their particle count is then set so that the cell's solid volume is exact.
+    """
+    k, i = np.nonzero(width > 0.0)
+    volume = frame.dx * frame.dz * width[k, i]
+    batches = []
+    for c, cls in enumerate(classes):
+        if cls.initial_volume_fraction <= 0.0:
+            continue
+        target = cls.initial_volume_fraction * volume
+        counts = np.maximum(1, np.rint(target / (particles_per_parcel[c]
+                                                 * cls.size.mean_particle_volume())).astype(int))
+        cell = np.repeat(np.arange(k.size), counts)
+        x, z = uniform_points(rng, frame, k, i, cell)
+        rank = np.arange(cell.size) - np.repeat(np.cumsum(counts) - counts, counts)
+        z = frame.z0 + (k[cell] - 0.5 + (rank + rng.random(cell.size)) / counts[cell]) * frame.dz
+        d = cls.size.sample(rng, cell.size)
+        vp = np.pi / 6.0 * d**3
+        per_cell = np.bincount(cell, weights=vp, minlength=k.size)
+        batches.append(make_batch(x, z, d, cls.density, (target / per_cell)[cell], c))
+    return concat_batches(batches)
+
+
+@dataclass
+class _Inlet:
+    k: np.ndarray
+    i: np.ndarray
+    share: float
+    owed: np.ndarray  # solid volume not yet emitted, per class [m^3]
+    next_diameter: np.ndarray  # diameter of the next parcel, per class (NaN: not drawn yet)
+
+
+class Injector:
+    """Slurry inlets on the grid: fluid sources and parcels for a step (t0, t1].
+
+    ``loadings(t)`` gives [(class index, slurry volume fraction)] at time t (from the schedule) and
+    ``rate(t0, t1)`` the mean slurry rate over the step [m^3/s]; the solid volume entering over the step is
+    c((t0+t1)/2) Q dt, exact while a step stays within one stage (the run loop ends steps at stage ends).
+    """
+
+    def __init__(self, ports: tuple[Port, ...], frame: GridFrame, width: np.ndarray,
+                 classes: tuple[ProppantClass, ...], particles_per_parcel: list[float], rate, loadings,
+                 rng: np.random.Generator):
+        self.frame = frame
+        self.shape = width.shape
+        self.classes = classes
+        self.particles_per_parcel = particles_per_parcel
+        self.rate = rate
+        self.loadings = loadings
+        self.rng = rng
+        total = sum(p.share for p in ports)
+        self.inlets = [_Inlet(k, i, p.share / total, np.zeros(len(classes)), np.full(len(classes), np.nan))
+                       for p, (k, i) in zip(ports, ports_to_cells(ports, frame, width, "geometry.inlets"))]
+
+    def fluid_sources(self, t0: float, t1: float) -> np.ndarray:
+        """Fluid volume rate per cell (nz, nx) [m^3/s]: (1 - c) Q split over the inlets and their cells
+        in proportion to the cells' volumes."""
+        q = self.rate(t0, t1) * (1.0 - sum(f for _, f in self.loadings(0.5 * (t0 + t1))))
+        return self._spread(q)
+
+    def slurry_sources(self, t0: float, t1: float) -> np.ndarray:
+        """Slurry volume rate per cell (nz, nx) [m^3/s] (fluid plus solids)."""
+        return self._spread(self.rate(t0, t1))
+
+    def _spread(self, q: float) -> np.ndarray:
+        out = np.zeros(self.shape)
+        for inlet in self.inlets:
+            np.add.at(out, (inlet.k, inlet.i), q * inlet.share / inlet.k.size)
+        return out
+
+    def emit(self, t0: float, t1: float) -> dict[str, np.ndarray]:
+        """Parcels entering during (t0, t1], placed uniformly at random in their inlet's cells, at rest."""
+        q = self.rate(t0, t1) * (t1 - t0)
+        batches = []
+        for c, fraction in self.loadings(0.5 * (t0 + t1)):
+            if fraction <= 0.0 or q <= 0.0:
+                continue
+            cls = self.classes[c]
+            ppp = self.particles_per_parcel[c]
+            for inlet in self.inlets:
+                inlet.owed[c] += fraction * q * inlet.share
+                d = self._draw(inlet, c, cls, ppp)
+                if d.size:
+                    cell = self.rng.integers(0, inlet.k.size, d.size)
+                    x, z = uniform_points(self.rng, self.frame, inlet.k, inlet.i, cell)
+                    batches.append(make_batch(x, z, d, cls.density, ppp, c))
+        return concat_batches(batches)
+
+    def _draw(self, inlet: _Inlet, c: int, cls: ProppantClass, ppp: float) -> np.ndarray:
+        """Diameters of the parcels whose volume the inlet owes, keeping the first one that does not fit."""
+        if np.isnan(inlet.next_diameter[c]):
+            inlet.next_diameter[c] = cls.size.sample(self.rng, 1)[0]
+        parcel_volume = ppp * cls.size.mean_particle_volume()
+        n = int(inlet.owed[c] / parcel_volume * 1.2) + 4
+        d = np.concatenate([[inlet.next_diameter[c]], cls.size.sample(self.rng, n)])
+        cumulative = np.cumsum(ppp * np.pi / 6.0 * d**3)
+        while cumulative[-1] <= inlet.owed[c]:  # a rare run of small particles: draw more
+            d = np.concatenate([d, cls.size.sample(self.rng, n)])
+            cumulative = np.cumsum(ppp * np.pi / 6.0 * d**3)
+        m = int(np.searchsorted(cumulative, inlet.owed[c], side="right"))
+        inlet.owed[c] -= cumulative[m - 1] if m else 0.0
+        inlet.next_diameter[c] = d[m]
+        return d[:m]
+
+    def owed_volume(self) -> float:
+        """Solid volume scheduled but not yet emitted (less than one parcel per inlet and class) [m^3]."""
+        return float(sum(inlet.owed.sum() for inlet in self.inlets))

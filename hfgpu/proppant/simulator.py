@@ -1,0 +1,357 @@
+"""The MP-PIC run loop (the paper, sections 2.3, 4.2, 4.3): grid, fluid solver, parcels, inlets, outlets.
+
+One fluid step of length dt (Courant limit Eq. 42 with C_max < 1, and the parcels' own Courant number over a
+particle sub-step; a step whose Courant number comes out above C_max is undone, halved and retried):
+
+1. the parcels entering during the step are added (:mod:`hfgpu.proppant.injection`);
+2. particle sub-loop (section 4.3), ``particle_substeps`` times dt/n in the fluid of the step's start:
+   scatter (Eq. 38) -> gather (Eq. 40-41) -> push (Eq. 43-44) -> exchange (Eq. 39); parcels in outlet cells
+   are removed and their solid volume counted;
+3. scatter: theta_p at the step's end, so that the fluid's storage term (theta_f w - theta_f^o w^o)/dt of
+   Eq. 25 is the change over this very step;
+4. fluid SIMPLE step (Algorithm 1) with theta_f = 1 - theta_p, the interphase force F averaged over the
+   sub-loop, the inlets' fluid sources (1 - c) Q, leak-off and the outlets;
+5. a :class:`hfgpu.records.SolidBalanceRecord` goes to the sink; snapshots every ``output.every``.
+This is the cycle scatter -> fluid -> particles of the paper entered at the particles: each fluid step sees
+the force of the particle sub-loop over the same interval.
+
+Solid balance: ``injected`` is all solid volume placed in the domain (the initial suspension plus the inlets),
+``in_domain`` the parcels' volume, ``outflow`` what left through outlets; injected = in_domain + outflow to
+round-off. A growing fracture can drive the loop through ``width_field(t) -> (width, leakoff)`` on the grid
+(cells that open join the fluid grid; leak-off [m/s per unit area, both faces] is the sink s_l of Eq. 7).
+
+The drag part of F is also handed to the fluid step as beta = sum n rho_p V_p D_p I / V_face, so that the
+fluid takes F = F^o + beta (u_f - u_f^o) implicitly: explicit drag would limit dt to ~2 rho_f theta_f / beta
+(under a millisecond in a packed bed of sand, where it drove spurious circulation).
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..errors import SimulationError
+from ..records import GridFrame, ProppantSnapshot, SolidBalanceRecord
+from .backend import get_backend
+from .config import Geometry, Port, ProppantSetup
+from .fluid import CourantLimitExceeded, FluidNumerics, FluidSolver
+from .grid import StaggeredGrid
+from .injection import Injector, batch_solid_volume, initial_suspension, ports_to_cells
+from .parcels import Parcels
+from .particle_ops_numpy import ParcelFluid, grid_fields
+
+WidthField = Callable[[float], "tuple[np.ndarray, np.ndarray]"]
+
+
+def build_grid(geometry: Geometry, mesh) -> StaggeredGrid:
+    """The staggered grid of a geometry: box/slot with round(length/dx) x round(height/dz) cells (the cell
+    size adjusted to fit exactly), field on the width file's own grid."""
+    if geometry.kind == "field":
+        x, z = geometry.field_x, geometry.field_z
+        frame = GridFrame(dx=float(x[1] - x[0]), dz=float(z[1] - z[0]), x0=float(x[0]), z0=float(z[0]))
+        return StaggeredGrid.from_width(frame, geometry.field_w)
+    nx = max(1, round(geometry.length / mesh.dx))
+    nz = max(1, round(geometry.height / mesh.dz))
+    return StaggeredGrid.box(geometry.length, geometry.height, geometry.width, nx, nz)
+
+
+def particles_per_parcel(setup: ProppantSetup, schedule, cell_volume: float) -> list[float]:
+    """Real particles per parcel of each class: the scene's value, or so that ``parcels_per_cell`` parcels
+    fill a cell of volume ``cell_volume`` at the class's largest volume fraction (initial or injected)."""
+    numerics = setup.numerics
+    if numerics.particles_per_parcel is not None:
+        return [numerics.particles_per_parcel] * len(setup.classes)
+    out = []
+    for cls in setup.classes:
+        fraction = cls.initial_volume_fraction
+        for stage in (schedule.stages if schedule is not None else ()):
+            if stage.proppant == cls.name:
+                fraction = max(fraction, stage.volume_fraction, stage.end_volume_fraction)
+        ppp = fraction * cell_volume / (numerics.parcels_per_cell * cls.size.mean_particle_volume())
+        out.append(ppp if ppp > 0.0 else 1.0)
+    return out
+
+
+def unit_slip(seen: ParcelFluid, parcels: Parcels) -> ParcelFluid:
+    """``seen`` with a fluid velocity 1 m/s faster than each parcel in x and z and no pressure gradient: the
+    exchange (Eq. 39) of it is the drag coefficient beta = sum n rho_p V_p D_p I / V_face on the faces."""
+    zero = np.zeros_like(seen.dpdx)
+    return dataclasses.replace(seen, fluid_u=parcels.u + 1.0, fluid_v=parcels.v + 1.0, dpdx=zero, dpdz=zero)
+
+
+@dataclass(frozen=True)
+class StepInfo:
+    """What one fluid step did."""
+
+    time: float
+    dt: float
+    simple_iterations: int
+    continuity_residual: float
+    courant: float
+    parcels: int
+    retries: int
+
+
+class ProppantSimulation:
+    """State and stepping of one MP-PIC run; :func:`simulate` drives it to the end time.
+
+    Attributes a caller may read: ``time``, ``grid``, ``parcels`` (:class:`Parcels`), ``fluid`` (the fluid
+    solver's state), ``injected``, ``outflow`` [m^3]. ``add_parcels`` places extra parcels (counted as
+    injected), e.g. a single test particle.
+    """
+
+    def __init__(self, scene, width_field: WidthField | None = None):
+        setup: ProppantSetup = scene.proppant
+        self.scene = scene
+        self.setup = setup
+        self.params = setup.params
+        self.numerics = setup.numerics
+        self.rho_f = scene.fluid.density
+        self.mu_f = scene.fluid.viscosity
+        self.width_field = width_field
+        self.backend = get_backend(self.numerics.backend, arch=self.numerics.arch)
+        self.grid = build_grid(setup.geometry, scene.mesh)
+        self.leakoff = np.zeros(self.grid.shape)
+        if width_field is not None:
+            self._set_width(0.0)
+        self.time = 0.0
+        self.rng = np.random.default_rng(scene.run.seed)
+        open_volume = self.grid.cell_volume[self.grid.active]
+        schedule = scene.injection.schedule if scene.injection is not None else None
+        self.particles_per_parcel = particles_per_parcel(setup, schedule, float(np.median(open_volume)))
+        self.parcels = Parcels.empty()
+        self.injected = 0.0
+        self.outflow = 0.0
+        self.add_parcels(initial_suspension(setup.classes, self.grid.frame, self.grid.width,
+                                            self.particles_per_parcel, self.rng))
+        self.injector = self._make_injector(schedule)
+        self.outlets = np.zeros(self.grid.shape, dtype=bool)
+        for k, i in ports_to_cells(setup.geometry.outlets, self.grid.frame, self.grid.width,
+                                   "geometry.outlets"):
+            self.outlets[k, i] = True
+        self.moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
+        n = self.numerics
+        self.solver = FluidSolver(self.grid, self.rho_f, self.mu_f,
+                                  FluidNumerics(c_max=n.c_max, tolerance=n.simple_tolerance,
+                                                max_iterations=n.simple_max_iterations),
+                                  self.backend,
+                                  params=self.params if n.slurry_viscosity else None)
+        self.fluid = self.solver.initial_state(self._fluid_theta_p())
+        self.steps = 0
+        self.safety = 1.0
+
+    # -- set-up ---------------------------------------------------------------------------------------
+
+    def _make_injector(self, schedule) -> Injector | None:
+        ports = self.setup.geometry.inlets
+        if schedule is None:
+            return None
+        if not ports:
+            ports = (Port("point", x=self.scene.injection.x, depth=self.scene.injection.depth),)
+        names = [c.name for c in self.setup.classes]
+
+        def loadings(t: float) -> list[tuple[int, float]]:
+            name, fraction = schedule.proppant_fraction(t)
+            return [] if name is None else [(names.index(name), fraction)]
+
+        return Injector(ports, self.grid.frame, self.grid.width, self.setup.classes, self.particles_per_parcel,
+                        rate=schedule.mean_rate, loadings=loadings, rng=self.rng)
+
+    def _set_width(self, t: float) -> None:
+        width, leakoff = self.width_field(t)
+        self.grid = self.grid.with_width(width)
+        self.leakoff = np.asarray(leakoff, dtype=float)
+
+    def add_parcels(self, batch: dict[str, np.ndarray]) -> None:
+        """Place parcels (shared layout arrays) in the domain; their solid volume counts as injected."""
+        if batch["x"].size:
+            self.parcels.append(Parcels(**batch))
+            self.injected += batch_solid_volume(batch)
+
+    # -- stepping -------------------------------------------------------------------------------------
+
+    def next_dt(self, limit: float) -> float:
+        """Largest step allowed: dt_max, the fluid Courant limit (Eq. 42), the parcels' Courant number per
+        sub-step (<= C_max), and ``limit`` (time to the next output, stage end or end time). The fluid limit
+        is scaled by ``safety``, which shrinks by 0.7 after a step needed a retry and recovers by 1.05 a step."""
+        h = min(self.grid.frame.dx, self.grid.frame.dz)
+        dt = min(self.numerics.dt_max, limit, self.safety * self.solver.stable_dt(self.fluid))
+        if self.parcels.n:
+            speed = float(np.max(np.abs(self.parcels.u) + np.abs(self.parcels.v)))
+            if speed > 0.0:
+                dt = min(dt, self.numerics.c_max * h * self.numerics.particle_substeps / speed)
+        return dt
+
+    def step(self, limit: float = math.inf) -> StepInfo:
+        """Advance one fluid step (at most ``limit`` seconds); see the module docstring."""
+        dt = self.next_dt(limit)
+        t0 = self.time
+        saved = self._save()
+        for retry in range(self.numerics.max_step_retries + 1):
+            if retry:
+                self._restore(saved)
+            if self.width_field is not None:
+                self._set_width(t0 + dt)
+                self.solver.set_grid(self.grid)
+            if self.injector is not None:
+                self.add_parcels(self.injector.emit(t0, t0 + dt))
+            force = self._particle_subloop(dt, t0)
+            self.moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
+            sources = (self.injector.fluid_sources(t0, t0 + dt) if self.injector is not None
+                       else np.zeros(self.grid.shape))
+            trial = self.solver.copy_state(self.fluid)
+            try:
+                info = self.solver.step(trial, dt, self._fluid_theta_p(), force[0],
+                                        force[1], sources=sources, leakoff=self.leakoff, outlets=self.outlets,
+                                        drag_x=force[2], drag_z=force[3])
+            except CourantLimitExceeded as exc:
+                dt = min(0.5 * dt, exc.stable_dt)
+                continue
+            if info.courant <= self.numerics.c_max:
+                break
+            dt *= 0.5
+        else:
+            raise SimulationError(f"the fluid Courant number stayed above c_max = {self.numerics.c_max:g} "
+                                  f"after {self.numerics.max_step_retries} halvings of the step", time=t0)
+        self.fluid = trial
+        self.safety = 0.7 * self.safety if retry else min(1.0, 1.05 * self.safety)
+        self._check_fluid(t0 + dt)
+        self.time = t0 + dt
+        self.steps += 1
+        return StepInfo(time=self.time, dt=dt, simple_iterations=info.iterations,
+                        continuity_residual=info.continuity_residual, courant=info.courant,
+                        parcels=self.parcels.n, retries=retry)
+
+    def _fluid_theta_p(self) -> np.ndarray:
+        """theta_p handed to the fluid, kept below 1 (only an over-packed cell, where the packing limiter
+        failed, reaches it). Not capped at close packing: the fluid's storage term (theta_f w)^n - (theta_f
+        w)^o must follow the parcels, or a bed reaching theta_cp breaks continuity (seen to blow up)."""
+        return np.minimum(self.moments.volume_fraction, 1.0 - 1e-6)
+
+    def _save(self) -> tuple:
+        """What a step changes before its Courant check, to undo it for a retry."""
+        return (self.parcels.copy(), copy.deepcopy(self.injector), self.injected, self.outflow, self.grid,
+                self.leakoff)
+
+    def _restore(self, saved: tuple) -> None:
+        parcels, injector, self.injected, self.outflow, self.grid, self.leakoff = saved
+        self.parcels, self.injector = parcels.copy(), copy.deepcopy(injector)
+        self.solver.set_grid(self.grid)
+
+    def _particle_subloop(self, dt: float, t0: float) -> tuple[np.ndarray, ...]:
+        """``particle_substeps`` x (scatter, gather, push, exchange, outlets) in the fluid of the step's start;
+        returns F_x, F_z (Eq. 39) and beta_x, beta_z averaged over the sub-steps."""
+        n = self.numerics.particle_substeps
+        h = dt / n
+        frame, width = self.grid.frame, self.grid.width
+        nz, nx = self.grid.shape
+        fx, bx = np.zeros((nz, nx + 1)), np.zeros((nz, nx + 1))
+        fz, bz = np.zeros((nz + 1, nx)), np.zeros((nz + 1, nx))
+        for s in range(n):
+            moments = self.backend.scatter(self.parcels, frame, width)
+            fields = grid_fields(frame, width, self.fluid.u, self.fluid.v, self.fluid.p, moments, self.params)
+            seen = self.backend.gather(self.parcels, frame, fields)
+            drag = self.backend.push(self.parcels, seen, frame, fields, h, self.params, self.rho_f, self.mu_f,
+                                     self.numerics.gravity)
+            force = self.backend.exchange(self.parcels, seen, drag, frame, width)
+            fx += force[0] / n
+            fz += force[1] / n
+            beta = self.backend.exchange(self.parcels, unit_slip(seen, self.parcels), drag, frame, width)
+            bx += beta[0] / n
+            bz += beta[1] / n
+            self._check_parcels(t0 + (s + 1) * h)
+            self._remove_outflow()
+        return fx, fz, bx, bz
+
+    def _remove_outflow(self) -> None:
+        if not self.outlets.any() or self.parcels.n == 0:
+            return
+        frame = self.grid.frame
+        i = np.clip(np.floor((self.parcels.x - frame.x0) / frame.dx + 0.5).astype(int), 0, self.grid.nx - 1)
+        k = np.clip(np.floor((self.parcels.z - frame.z0) / frame.dz + 0.5).astype(int), 0, self.grid.nz - 1)
+        leaving = self.outlets[k, i]
+        if leaving.any():
+            self.outflow += float(np.sum(self.parcels.solid_volume()[leaving]))
+            self.parcels.drop(leaving)
+
+    def _check_fluid(self, t: float) -> None:
+        for name in ("u", "v", "p"):
+            values = getattr(self.fluid, name)
+            bad = ~np.isfinite(values)
+            if bad.any():
+                cell = tuple(int(c) for c in np.argwhere(bad)[0])
+                raise SimulationError(f"non-finite fluid {name}", time=t, cell=cell)
+
+    def _check_parcels(self, t: float) -> None:
+        p = self.parcels
+        bad = ~(np.isfinite(p.x) & np.isfinite(p.z) & np.isfinite(p.u) & np.isfinite(p.v))
+        if bad.any():
+            j = int(np.argmax(bad))
+            frame = self.grid.frame
+            cell = (int(math.floor((p.z[j] - frame.z0) / frame.dz + 0.5)) if np.isfinite(p.z[j]) else None,
+                    int(math.floor((p.x[j] - frame.x0) / frame.dx + 0.5)) if np.isfinite(p.x[j]) else None)
+            raise SimulationError(f"non-finite state of parcel {j}", time=t, cell=cell)
+
+    # -- records --------------------------------------------------------------------------------------
+
+    def snapshot(self) -> ProppantSnapshot:
+        """Parcels and grid fields now (the records' layout)."""
+        self.moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
+        return ProppantSnapshot(
+            time=self.time, frame=self.grid.frame, parcels=self.parcels.as_dict(),
+            grid=dict(volume_fraction=self.moments.volume_fraction.copy(), pressure=self.fluid.p.copy(),
+                      width=np.array(self.grid.width), fluid_u=self.fluid.u.copy(),
+                      fluid_v=self.fluid.v.copy()))
+
+    def balance(self) -> SolidBalanceRecord:
+        return SolidBalanceRecord(time=self.time, injected=self.injected,
+                                  in_domain=float(np.sum(self.parcels.solid_volume())), outflow=self.outflow)
+
+    def run(self, sink, progress: Callable[[float], None] | None = None,
+            on_step: Callable[[StepInfo], None] | None = None) -> dict:
+        """Step to the scene's end time, writing snapshots every ``output.every`` (and at 0 and the end) and
+        a balance record every step; returns a summary."""
+        end = self.scene.run.end_time
+        every = self.scene.output.every
+        breaks = sorted(b for b in (self.scene.injection.schedule.breakpoints()
+                                    if self.scene.injection is not None else ()) if 0.0 < b < end)
+        next_out = 0.0
+        eps = 1e-9 * end
+        max_residual = 0.0
+        while True:
+            if self.time >= next_out - eps:
+                sink.proppant_snapshot(self.snapshot())
+                next_out += every
+            if self.time >= end - eps:
+                break
+            targets = [end, next_out] + [b for b in breaks if b > self.time + eps]
+            info = self.step(limit=min(targets) - self.time)
+            max_residual = max(max_residual, info.continuity_residual)
+            sink.proppant_balance(self.balance())
+            if on_step is not None:
+                on_step(info)
+            if progress is not None:
+                progress(self.time)
+        if abs(self.time - (next_out - every)) > eps:
+            sink.proppant_snapshot(self.snapshot())
+        record = self.balance()
+        return dict(time=self.time, steps=self.steps, parcels=self.parcels.n, injected=record.injected,
+                    in_domain=record.in_domain, outflow=record.outflow,
+                    max_continuity_residual=max_residual, backend=self.numerics.backend)
+
+
+def simulate(scene, sink, progress: Callable[[float], None] | None = None,
+             width_field: WidthField | None = None) -> dict:
+    """Run the MP-PIC proppant model of ``scene`` (physics "proppant") to its end time.
+
+    ``sink`` receives ``proppant_snapshot`` and ``proppant_balance`` records (hfgpu.records); ``progress(t)``
+    is called after every fluid step; ``width_field(t) -> (width, leakoff)`` optionally drives the width and
+    leak-off fields (nz, nx) of the grid in time (coupling to a growing fracture). Returns a summary dict
+    (time, steps, parcels, injected, in_domain, outflow, max_continuity_residual, backend).
+    """
+    return ProppantSimulation(scene, width_field=width_field).run(sink, progress)

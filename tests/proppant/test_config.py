@@ -1,0 +1,109 @@
+"""The proppant scene tables: [geometry], [[proppant]], [mppic] -- values in SI, errors naming key and rule."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hfgpu import SceneError, load_scene
+
+BOX = """
+[run]
+end_time = "10 s"
+physics = ["proppant"]
+[fluid]
+viscosity = "1 cP"
+[mesh]
+cell_size = "1 cm"
+[output]
+every = "1 s"
+[geometry]
+kind = "box"
+length = "5 cm"
+height = "1 m"
+width = "5 cm"
+[[proppant]]
+name = "heavy"
+density = "2990 kg/m**3"
+diameter = "198 um"
+initial_volume_fraction = 0.01
+[[proppant]]
+name = "sand"
+density = 2550
+size = "30/50"
+[mppic]
+backend = "numpy"
+theta_cp = 0.62
+damping = false
+"""
+
+
+def test_box_scene_to_si():
+    setup = load_scene(BOX).proppant
+    assert setup.geometry.kind == "box" and setup.geometry.height == 1.0 and setup.geometry.width == 0.05
+    heavy, sand = setup.classes
+    assert heavy.size.kind == "fixed" and heavy.size.mean == pytest.approx(198e-6)
+    assert sand.size.kind == "normal" and (sand.size.d_min, sand.size.d_max) == pytest.approx((3e-4, 6e-4))
+    assert setup.class_densities() == {"heavy": 2990.0, "sand": 2550.0}
+    assert setup.params.theta_cp == 0.62 and setup.params.damping is False
+    assert setup.numerics.backend == "numpy"
+
+
+def test_injection_concentration_uses_class_density():
+    text = BOX.replace('kind = "box"', 'kind = "slot"').replace("[[proppant]]", """
+[[geometry.inlets]]
+kind = "segment"
+x = 0
+depth = "10 cm"
+x_end = 0
+depth_end = "12 cm"
+[[geometry.outlets]]
+kind = "point"
+x = "5 cm"
+depth = "10 cm"
+[injection]
+schedule = [{ until = "10 s", rate = "6 gpm", proppant = "sand", concentration = "1.5 ppg" }]
+[[proppant]]""", 1)
+    scene = load_scene(text)
+    # REFERENCE.md section 5: 1.5 ppg of 2550 kg/m^3 sand -> slurry fraction 0.065845
+    assert scene.injection.schedule.proppant_fraction(1.0) == ("sand", pytest.approx(0.065845, abs=2e-6))
+    inlet = scene.proppant.geometry.inlets[0]
+    assert inlet.kind == "segment" and inlet.depth_end == pytest.approx(0.12)
+
+
+@pytest.mark.parametrize("old, new, path", [
+    ('kind = "box"', 'kind = "tube"', "geometry.kind"),
+    ('width = "5 cm"', 'width = "-5 cm"', "geometry.width"),
+    ('diameter = "198 um"', 'diameter = "198 um"\nsize = "30/50"', "proppant[0].diameter"),
+    ('size = "30/50"', 'size = "50/30"', "proppant[1].size"),
+    ('initial_volume_fraction = 0.01', 'initial_volume_fraction = 0.7', "proppant[0].initial_volume_fraction"),
+    ('backend = "numpy"', 'backend = "cuda"', "mppic.backend"),
+    ('theta_cp = 0.62', 'theta_cp = 1.5', "mppic.theta_cp"),
+    ('damping = false', 'damping = 3', "mppic.damping"),
+    ('damping = false', 'c_max = 1.2', "mppic.c_max"),
+    ('damping = false', 'substeps = 3', "mppic.substeps"),
+    ('damping = false', 'slurry_viscosity = "no"', "mppic.slurry_viscosity"),
+    ('damping = false', 'particle_substeps = 0', "mppic.particle_substeps"),
+    ('kind = "box"', 'kind = "slot"', "geometry.inlets"),
+])
+def test_errors_name_key_path(old, new, path):
+    with pytest.raises(SceneError) as err:
+        load_scene(BOX.replace(old, new))
+    assert err.value.path == path
+
+
+def test_field_geometry_from_npz(tmp_path):
+    x = 0.005 + 0.01 * np.arange(4)
+    z = 0.005 + 0.01 * np.arange(3)
+    w = np.full((3, 4), 2e-3)
+    w[0, 0] = 0.0
+    np.savez(tmp_path / "w.npz", x=x, z=z, w=w)
+    text = BOX.replace('kind = "box"\nlength = "5 cm"\nheight = "1 m"\nwidth = "5 cm"',
+                       f'kind = "field"\nfile = "{tmp_path / "w.npz"}"')
+    g = load_scene(text).proppant.geometry
+    assert g.length == pytest.approx(0.04) and g.height == pytest.approx(0.03)
+    np.testing.assert_array_equal(g.field_w, w)
+    with pytest.raises(SceneError, match="spacing"):
+        load_scene(text.replace('cell_size = "1 cm"', 'cell_size = "2 cm"'))
+    with pytest.raises(SceneError, match="no such width file"):
+        load_scene(text.replace("w.npz", "missing.npz"))
