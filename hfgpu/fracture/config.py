@@ -14,6 +14,14 @@ class FractureNumerics:
     time_step_relaxation: lambda of Eq. 35, dt = lambda min(dx, dz) / max(V_T).
     newton_tolerance: epsilon of Eq. 32 (relative).
     linear_solver: "auto" (direct below ``krylov_threshold`` cells, Newton-Krylov above), "direct", "krylov".
+    newton_max_iterations: Newton iterations per step before the step is retried with half the time step.
+    max_step_retries: halvings of a failed step before the run stops with a SimulationError.
+    initial_radius_cells: radius of the starting radial fracture, in cells (see front.initial_fracture).
+    tip_asymptote: "olson" (Eq. 33, toughness only: 0.806 w = K'/E' s^1/2) or "km" (the larger of the
+        toughness and viscosity (M-vertex) tip asymptotes, see front.py) used for front advance.
+    leakoff_width_fraction: width scale of the leak-off positivity ramp (leakoff.available_fraction) as a
+        fraction of the step's Carter demand; a cell never leaks fluid it does not hold.
+    max_step_growth: largest ratio of one time step to the previous one.
     """
 
     time_step_relaxation: float = 0.5
@@ -22,6 +30,10 @@ class FractureNumerics:
     linear_solver: str = "auto"
     krylov_threshold: int = 3000
     max_step_retries: int = 8
+    initial_radius_cells: float = 2.5
+    tip_asymptote: str = "km"
+    leakoff_width_fraction: float = 0.01
+    max_step_growth: float = 1.5
 
 
 def parse_fracture_numerics(t: Table) -> FractureNumerics:
@@ -35,6 +47,12 @@ def parse_fracture_numerics(t: Table) -> FractureNumerics:
         linear_solver=t.choice("linear_solver", ("auto", "direct", "krylov"), d.linear_solver),
         krylov_threshold=t.integer("krylov_threshold", d.krylov_threshold, minimum=1),
         max_step_retries=t.integer("max_step_retries", d.max_step_retries, minimum=0),
+        initial_radius_cells=t.number("initial_radius_cells", d.initial_radius_cells, minimum=1.0,
+                                      maximum=50.0),
+        tip_asymptote=t.choice("tip_asymptote", ("olson", "km"), d.tip_asymptote),
+        leakoff_width_fraction=t.number("leakoff_width_fraction", d.leakoff_width_fraction, minimum=0.0,
+                                        maximum=1.0, exclusive_minimum=True),
+        max_step_growth=t.number("max_step_growth", d.max_step_growth, minimum=1.0, maximum=10.0),
     )
     t.finish()
     return numerics

@@ -1,0 +1,120 @@
+"""Fixed-grid front tracking (Eq. 33-35): tip asymptotes, element activation, tip speeds, time step.
+
+Front advance. An inactive cell next to the fracture opens when the width of its active 4-neighbour (the
+tip element) says the front has reached their shared edge, at distance s = h/2 from the tip element's
+centre (h = dx or dz). The paper uses Olson's criterion (Eq. 33), 0.806 w = K'/E' s^(1/2), i.e. the
+linear-elastic (toughness) tip asymptote with Olson's (1991) correction of the constant-DD tip width.
+On its own that asymptote says "propagate" for almost any width when K' is small (viscosity-dominated
+growth), so the default ``tip_asymptote = "km"`` uses the larger of the toughness asymptote and the
+viscosity (M-vertex) asymptote of Desroches et al. (1994), w = beta_m (mu' V / E')^(1/3) s^(2/3),
+beta_m = 2^(1/3) 3^(5/6) (REFERENCE.md 1.3): a cheap envelope of the universal K-M asymptote of Dontsov &
+Peirce (2015), exact at both ends. Olson's 0.806 multiplies the toughness term only: it was derived for
+the s^(1/2) profile of constant-DD tip elements, not for the s^(2/3) viscous one. V is the fluid velocity through
+the tip element's inner face towards the candidate cell (at the tip, fluid and front move together).
+Leak-off needs no extra rule: a new cell's Carter demand (tau = its opening time) keeps it nearly empty
+until the inflow exceeds it. Opened cells never close, so the front cannot retreat.
+
+Sub-grid front. The same asymptote, inverted at the cells on the fracture's edge, locates the front
+inside the grid: the simulator's front summary takes, for each edge cell, its centre's distance from the
+injection point plus the inverted distance s (capped at one cell), which measures the radius of a radial
+fracture more finely than whole cells, and the extents up/down/left/right the same way.
+
+Tip speeds and time step. A cell opened at time t from a parent tip element opened at t_P records
+V_T = d / (t - t_P) (Eq. 34), d the centre distance; the next step is dt = lambda min(dx, dz) / max V_T
+(Eq. 35) over the cells opened most recently.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+OLSON = 0.806
+BETA_M = 2.0 ** (1.0 / 3.0) * 3.0 ** (5.0 / 6.0)
+
+# (row shift, column shift) of the four neighbours: +x, -x, +z, -z.
+DIRECTIONS = ((0, 1), (0, -1), (1, 0), (-1, 0))
+
+
+@dataclass(frozen=True)
+class TipModel:
+    """Material constants of the tip asymptote: E', mu' = 12 mu and the asymptote's name."""
+
+    e_prime: float
+    mu_prime: float
+    mode: str  # "olson" or "km"
+
+
+def tip_width(model: TipModel, k_prime: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Cell width that puts the front at distance s: Eq. 33, 0.806 w = K'/E' s^(1/2), or with "km" the
+    larger of that and w = beta_m (mu' V / E')^(1/3) s^(2/3) (M-vertex asymptote)."""
+    w = k_prime / model.e_prime * np.sqrt(s) / OLSON
+    if model.mode == "km":
+        w = np.maximum(w, BETA_M * np.cbrt(model.mu_prime * np.maximum(v, 0.0) / model.e_prime) * s ** (2 / 3))
+    return w
+
+
+def invert_tip(model: TipModel, k_prime: np.ndarray, w: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Distance s from a cell centre to the front implied by its width w: the inverse of ``tip_width``."""
+    w = np.maximum(w, 0.0)
+    with np.errstate(divide="ignore"):
+        s = np.where(k_prime > 0.0, (OLSON * w * model.e_prime / np.where(k_prime > 0, k_prime, 1.0)) ** 2,
+                     np.inf)
+        if model.mode == "km":
+            scale = BETA_M * np.cbrt(model.mu_prime * np.maximum(v, 0.0) / model.e_prime)
+            s = np.minimum(s, np.where(scale > 0.0, (w / np.where(scale > 0, scale, 1.0)) ** 1.5, np.inf))
+    return s
+
+
+def _shift(a: np.ndarray, dk: int, di: int, fill) -> np.ndarray:
+    """b[k, i] = a[k - dk, i - di] (the neighbour on the -(dk, di) side), ``fill`` outside the box."""
+    out = np.full_like(a, fill)
+    nz, nx = a.shape
+    out[max(dk, 0):nz + min(dk, 0), max(di, 0):nx + min(di, 0)] = \
+        a[max(-dk, 0):nz + min(-dk, 0), max(-di, 0):nx + min(-di, 0)]
+    return out
+
+
+def inflow_velocity(active: np.ndarray, w: np.ndarray, p: np.ndarray, h: float, dk: int, di: int,
+                    mu_prime: float) -> np.ndarray:
+    """Mean fluid velocity through each cell's face on the -(dk, di) side, positive along (dk, di):
+    v = (w_a + w_b)^2 / (4 mu') (p_a - p_b) / h (Poiseuille, Eq. 23); 0 where either cell is inactive."""
+    w_in = _shift(w, dk, di, 0.0)
+    p_in = _shift(p, dk, di, 0.0)
+    both = active & _shift(active, dk, di, False)
+    v = (np.maximum(w_in, 0) + np.maximum(w, 0)) ** 2 / (4.0 * mu_prime) * (p_in - p) / h
+    return np.where(both, np.maximum(v, 0.0), 0.0)
+
+
+def cells_to_open(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndarray, k_prime: np.ndarray,
+                  reached: np.ndarray, t: float, dx: float, dz: float):
+    """Inactive cells whose tip element satisfies the front criterion (Eq. 33) at s = h/2.
+
+    Returns a boolean mask of cells to open and their tip speeds V_T = d / (t - t_parent) (Eq. 34), the
+    fastest over the triggering parents (NaN where nothing opens). ``reached`` holds the times the front
+    reached each cell.
+    """
+    to_open = np.zeros_like(active)
+    speed = np.full(active.shape, np.nan)
+    for dk, di in DIRECTIONS:
+        h = dz if dk else dx
+        v = inflow_velocity(active, w, p, h, dk, di, model.mu_prime)
+        ok = active & (w >= tip_width(model, k_prime, np.full(w.shape, 0.5 * h), v))
+        # candidate = the cell on the (dk, di) side of a triggering tip element
+        cand = _shift(ok, dk, di, False) & ~active
+        parent_time = _shift(reached, dk, di, np.nan)
+        vt = h / np.maximum(t - parent_time, 1e-300)
+        speed = np.where(cand, np.fmax(speed, vt), speed)
+        to_open |= cand
+    return to_open, speed
+
+
+def edge_cells(active: np.ndarray) -> np.ndarray:
+    """Active cells with at least one inactive 4-neighbour."""
+    edge = np.zeros_like(active)
+    for dk, di in DIRECTIONS:
+        edge |= active & ~_shift(active, dk, di, False)
+    return edge
+
+

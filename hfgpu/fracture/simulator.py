@@ -1,0 +1,303 @@
+"""The planar-3D fracture engine's time loop: ``simulate(scene, sink, progress=None) -> summary``.
+
+Each step [t, t + dt] solves the implicit elasticity-lubrication-leak-off system for the widths of the
+active cells (Newton, :mod:`newton`), then opens the cells the front criterion selects (:mod:`front`) and
+chooses the next step by Eq. 35. Steps land on schedule breakpoints, output times and the end time; a step
+whose Newton iteration fails is retried with half the step (``max_step_retries`` times, then
+SimulationError naming time, cell and residual). The injected volume of a step is exact
+(Schedule.mean_rate), leak-off is Carter's law integrated exactly (:mod:`leakoff`), and the flux form
+conserves volume, so injected = stored + leaked to the Newton tolerance at every step.
+
+Start. The run starts at t0 from a radial fracture of radius R0 = ``initial_radius_cells`` cells (the
+cells whose centres lie inside it). t0 is the latest of the times at which the four radial vertex solutions
+(M, K, Mt, Kt; REFERENCE.md 1.1) reach R0 with the properties at the injection point -- the slowest
+mechanism controls early growth -- and the cells' opening times follow that vertex's R ~ t^a
+(tau = t0 (r / R0)^(1/a)). The cells hold the volume injected by t0 less the Carter volume leaked since
+their opening times (at most 90 % of it), in the shape a uniform net pressure gives (C w = const).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import numpy as np
+
+from ..errors import SceneError, SimulationError
+from ..records import BalanceRecord, FractureSnapshot, GridFrame
+from .config import FractureNumerics
+from .elasticity import ElasticityOperator
+from .front import DIRECTIONS, TipModel, cells_to_open, edge_cells, invert_tip
+from .leakoff import carter_volume
+from .lubrication import build_faces
+from .mesh import GROW, Grid
+from .newton import Elasticity, StepProblem, solve_step
+
+K_PRIME_FACTOR = math.sqrt(32.0 / math.pi)   # K' = sqrt(32/pi) K_Ic
+
+
+def _check_scene(scene) -> None:
+    """Reject what the engine cannot run before any work starts."""
+    if scene.rock is None or scene.injection is None:
+        raise SceneError("rock" if scene.rock is None else "injection", "(missing)",
+                         "the fracture engine needs [rock] and [injection]")
+    first = scene.injection.schedule.stages[0]
+    if first.rate <= 0.0:
+        raise SceneError("injection.schedule[0].rate", first.rate,
+                         "the first stage must inject (rate > 0) to start a fracture")
+    if scene.mesh.max_cells_across is not None:
+        raise SceneError("mesh.max_cells_across", scene.mesh.max_cells_across,
+                         "coarsening is not implemented in the fracture engine yet; leave it out")
+
+
+def initial_time(e_prime: float, mu_prime: float, k_prime: float, c_prime: float, q: float,
+                 radius: float) -> tuple[float, float]:
+    """(t0, a): the latest time at which a radial vertex solution reaches ``radius`` and its exponent a
+    (R ~ t^a). Vertices (REFERENCE.md 1.1): M R = 0.6955 (E' Q^3 t^4 / mu')^(1/9); K R = 0.8546
+    (E' Q t / K')^(2/5); Mt = Kt R = 0.4502 (Q^2 t / C'^2)^(1/4)."""
+    times = [((radius / 0.6955) ** 9 * mu_prime / (e_prime * q**3)) ** 0.25, ]
+    powers = [4.0 / 9.0]
+    if k_prime > 0.0:
+        times.append((radius / 0.8546) ** 2.5 * k_prime / (e_prime * q))
+        powers.append(0.4)
+    if c_prime > 0.0:
+        times.append((radius / 0.4502) ** 4 * c_prime**2 / q**2)
+        powers.append(0.25)
+    i = int(np.argmax(times))
+    return float(times[i]), powers[i]
+
+
+class _Engine:
+    """Mutable state of one run (grid fields, active-set systems, counters)."""
+
+    def __init__(self, scene, numerics: FractureNumerics):
+        self.scene, self.num = scene, numerics
+        rock, inj = scene.rock, scene.injection
+        self.dx, self.dz = scene.mesh.dx, scene.mesh.dz
+        self.area = self.dx * self.dz
+        self.e_prime = rock.plane_strain_modulus
+        self.mu_prime = 12.0 * scene.fluid.viscosity
+        self.schedule = inj.schedule
+        self.tip = TipModel(self.e_prime, self.mu_prime, numerics.tip_asymptote)
+        self.op = ElasticityOperator(self.dx, self.dz, self.e_prime)
+        h = max(self.dx, self.dz)
+        r0 = numerics.initial_radius_cells * h
+        half = int(math.ceil(r0 / min(self.dx, self.dz))) + GROW
+        self.grid = Grid.around_injection(self.dx, self.dz, inj.x, inj.depth, half)
+        self._properties()
+        k0 = K_PRIME_FACTOR * float(rock.toughness_at(np.array(inj.depth)))
+        c0 = 2.0 * float(rock.leakoff_at(np.array(inj.depth)))
+        self.t0, power = initial_time(self.e_prime, self.mu_prime, k0, c0, self.schedule.stages[0].rate, r0)
+        if self.t0 >= self.schedule.stages[0].until:
+            raise SceneError("fracture.initial_radius_cells", numerics.initial_radius_cells,
+                             f"the starting fracture ({r0:.3g} m) would take {self.t0:.3g} s to form, past the "
+                             f"first stage's end ({self.schedule.stages[0].until:g} s); use a finer mesh")
+        g = self.grid
+        xo, zo = g.offsets()
+        r = np.hypot(xo, zo)
+        g["active"][...] = r < r0
+        g["active"][r == r.min()] = True
+        act = g["active"]
+        g["opened"][act] = self.t0 * (r[act] / r0) ** (1.0 / power)
+        g["reached"][act] = g["opened"][act]
+        self._rebuild()
+        leaked = self.area * carter_volume(self.cprime_a, g["opened"][act], 0.0, self.t0)
+        injected = self.schedule.volume(self.t0)
+        if leaked.sum() > 0.9 * injected:
+            leaked *= 0.9 * injected / leaked.sum()
+        shape = np.linalg.solve(self.elastic.matrix if self.elastic.matrix is not None
+                                else self.op.dense(self.ix, self.iz), np.ones(self.ix.size))
+        g["w"][act] = shape * (injected - leaked.sum()) / (self.area * shape.sum())
+        self.leaked_total = float(leaked.sum())
+        self.t = self.t0
+        self.v_front = power * r0 / self.t0
+        self.t_front = self.t0
+        self.steps = self.newton_iterations = self.retries = 0
+        self.max_balance_error = 0.0
+
+    def _properties(self) -> None:
+        """sigma_0, K' = sqrt(32/pi) K_Ic and C' = 2 C_L at every box cell, from the layer table."""
+        _, z = self.grid.centres()
+        rock = self.scene.rock
+        self.sigma_box = rock.min_stress_at(z)
+        self.kprime_box = K_PRIME_FACTOR * rock.toughness_at(z)
+        self.cprime_box = 2.0 * rock.leakoff_at(z)
+
+    def _rebuild(self) -> None:
+        """Systems of the current active set: indices, faces, C (dense or FFT), properties."""
+        self.rows, self.cols, self.ix, self.iz = self.grid.active_indices()
+        n = self.ix.size
+        solver = self.num.linear_solver
+        dense = solver == "direct" or (solver == "auto" and n < self.num.krylov_threshold)
+        self.elastic = Elasticity(self.op, self.ix, self.iz, dense)
+        self.faces = build_faces(self.ix, self.iz, self.dx, self.dz, self.mu_prime)
+        sel = (self.rows, self.cols)
+        self.sigma_a, self.cprime_a = self.sigma_box[sel], self.cprime_box[sel]
+        self.inj = int(np.flatnonzero((self.ix == 0) & (self.iz == 0))[0])
+
+    # ------------------------------------------------------------------------------------------
+    def step(self, dt: float) -> float:
+        """Advance by dt (halved on Newton failure); returns the step taken."""
+        g = self.grid
+        sel = (self.rows, self.cols)
+        w_old = g["w"][sel]
+        tau = g["opened"][sel]
+        for attempt in range(self.num.max_step_retries + 1):
+            source = np.zeros(w_old.size)
+            source[self.inj] = self.schedule.mean_rate(self.t, self.t + dt) * dt
+            demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt)
+            w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
+            prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
+                               demand, w_eps, 1e-3 * float(w_old.max()))
+            res = solve_step(prob, self.elastic, self.num.newton_tolerance, self.num.newton_max_iterations)
+            self.newton_iterations += res.iterations
+            if res.converged:
+                break
+            if attempt == self.num.max_step_retries:
+                worst = int(np.nanargmax(np.where(np.isfinite(res.residual), np.abs(res.residual), np.inf)))
+                raise SimulationError("Newton iteration failed after the allowed step retries",
+                                      time=self.t + dt, cell=(int(self.ix[worst]), int(self.iz[worst])),
+                                      residual=float(np.abs(res.residual[worst]) / self.area))
+            self.retries += 1
+            dt *= 0.5
+        if not (np.all(np.isfinite(res.w)) and np.all(np.isfinite(res.p))):
+            raise SimulationError("non-finite width or pressure", time=self.t + dt)
+        self.t += dt
+        g["w"][sel] = res.w
+        g["p"][sel] = res.p
+        g["leak_rate"][sel] = res.leaked / (self.area * dt)
+        self.leaked_total += float(res.leaked.sum())
+        self.steps += 1
+        self._advance_front()
+        return dt
+
+    def _advance_front(self) -> None:
+        """Open the cells the front criterion selects (Eq. 33) and record the tip speed (Eq. 34)."""
+        g = self.grid
+        to_open, speed = cells_to_open(self.tip, g["active"], g["w"], g["p"], self.kprime_box,
+                                       g["reached"], self.t, self.dx, self.dz)
+        if not to_open.any():
+            return
+        g.fields["active"] = g["active"] | to_open
+        g["reached"][to_open] = self.t
+        g["opened"][to_open] = self.t
+        g["w"][to_open] = 0.0
+        self.v_front = float(np.nanmax(speed))
+        self.t_front = self.t
+        before = g.shape
+        g.ensure_margin()
+        if g.shape != before:
+            self._properties()
+        self._rebuild()
+
+    def next_dt(self, dt_prev: float) -> float:
+        """Eq. 35, dt = lambda min(dx, dz) / V_T, with V_T the latest front speed, no larger than the
+        bound h / (time since the last opening) it must satisfy, and growth limited by max_step_growth."""
+        h = min(self.dx, self.dz)
+        v = self.v_front
+        if self.t > self.t_front:
+            v = min(v, h / (self.t - self.t_front))
+        return min(self.num.time_step_relaxation * h / v, self.num.max_step_growth * dt_prev)
+
+    # ------------------------------------------------------------------------------------------
+    def balance(self) -> BalanceRecord:
+        stored = float(self.grid["w"][self.grid["active"]].sum()) * self.area
+        return BalanceRecord(time=self.t, injected=self.schedule.volume(self.t), stored=stored,
+                             leaked=self.leaked_total)
+
+    def snapshot(self) -> FractureSnapshot:
+        g = self.grid
+        rs, cs = g.bounding_box(1)
+        x, z = g.centres()
+        act = g["active"][rs, cs]
+        frame = GridFrame(self.dx, self.dz, float(x[rs, cs][0, 0]), float(z[rs, cs][0, 0]))
+        return FractureSnapshot(
+            time=self.t, frame=frame, width=np.where(act, g["w"][rs, cs], 0.0),
+            pressure=np.where(act, g["p"][rs, cs], 0.0),
+            leakoff_rate=np.where(act, g["leak_rate"][rs, cs], 0.0),
+            opening_time=np.where(act, g["opened"][rs, cs], np.nan),
+            extras={f"front_{k}": np.array(v) for k, v in self.front().items()})
+
+    def front(self) -> dict:
+        """Sub-grid front: distances r + s from the injection point at the edge cells (s from the inverted
+        tip asymptote, capped at one cell) and the extents up (-z), down (+z), left (-x), right (+x)."""
+        g = self.grid
+        act, w, p = g["active"], g["w"], g["p"]
+        xo, zo = g.offsets()
+        edge = edge_cells(act)
+        radii = []
+        ext = {"right": 0.0, "left": 0.0, "down": 0.0, "up": 0.0}
+        names = ("right", "left", "down", "up")
+        nz, nx = act.shape
+        for k, i in zip(*np.nonzero(edge)):
+            best = 0.0
+            for name, (dk, di) in zip(names, DIRECTIONS):
+                kk, ii = k + dk, i + di
+                if 0 <= kk < nz and 0 <= ii < nx and act[kk, ii]:
+                    continue
+                h = self.dz if dk else self.dx
+                kb, ib = k - dk, i - di
+                v = 0.0
+                if 0 <= kb < nz and 0 <= ib < nx and act[kb, ib]:
+                    wf = max(w[kb, ib], 0.0) + max(w[k, i], 0.0)
+                    v = max(wf**2 / (4.0 * self.mu_prime) * (p[kb, ib] - p[k, i]) / h, 0.0)
+                s = min(float(invert_tip(self.tip, np.array(self.kprime_box[k, i]), np.array(w[k, i]),
+                                         np.array(v))), h)
+                best = max(best, s)
+                coord = (zo[k, i] * dk if dk else xo[k, i] * di) + s
+                ext[name] = max(ext[name], coord)
+            radii.append(math.hypot(xo[k, i], zo[k, i]) + best)
+        radii = np.array(radii)
+        return dict(radius=float(radii.mean()), radius_min=float(radii.min()), radius_max=float(radii.max()),
+                    area_radius=math.sqrt(act.sum() * self.area / math.pi), **ext)
+
+
+def _targets(scene, t0: float) -> tuple[list[float], set[float]]:
+    """(times steps must land on, output times): schedule breakpoints, every ``output.every`` and the end."""
+    end = scene.run.end_time
+    every = scene.output.every
+    outputs = {every * k for k in range(1, int(math.floor(end / every + 1e-9)) + 1)} | {end}
+    outputs = {t for t in outputs if t0 < t <= end}
+    times = outputs | {b for b in scene.injection.schedule.breakpoints() if t0 < b < end}
+    return sorted(times), outputs
+
+
+def simulate(scene, sink, progress: Callable[[float], None] | None = None) -> dict:
+    """Run the planar-3D fracture model of ``scene`` to ``run.end_time`` (paper sections 2.2, 3.1).
+
+    Calls ``sink.fracture_balance(BalanceRecord)`` after every accepted step and
+    ``sink.fracture_snapshot(FractureSnapshot)`` at every ``output.every`` and at the end; ``progress(t)``
+    after each step. Returns a summary: time, steps, newton_iterations, retries, cells, the sub-grid front
+    (radius, radius_min, radius_max, area_radius, up, down, left, right), w_inlet, p_inlet, the final
+    balance (injected, stored, leaked) and max_balance_error (relative).
+    """
+    _check_scene(scene)
+    numerics = scene.fracture if scene.fracture is not None else FractureNumerics()
+    eng = _Engine(scene, numerics)
+    targets, outputs = _targets(scene, eng.t0)
+    dt = numerics.time_step_relaxation * min(eng.dx, eng.dz) / eng.v_front
+    for target in targets:
+        while eng.t < target * (1 - 1e-12):
+            remaining = target - eng.t
+            step = min(dt, remaining)
+            if remaining - step < 1e-3 * step:
+                step = remaining
+            taken = eng.step(step)
+            if abs(eng.t - target) < 1e-9 * target:
+                eng.t = target
+            record = eng.balance()
+            error = abs(record.injected - record.stored - record.leaked) / record.injected
+            eng.max_balance_error = max(eng.max_balance_error, error)
+            sink.fracture_balance(record)
+            if progress is not None:
+                progress(eng.t)
+            dt = eng.next_dt(dt if taken == step else taken)
+        if target in outputs:
+            sink.fracture_snapshot(eng.snapshot())
+    g = eng.grid
+    inj = (eng.rows[eng.inj], eng.cols[eng.inj])
+    final = eng.balance()
+    return dict(time=eng.t, t0=eng.t0, steps=eng.steps, newton_iterations=eng.newton_iterations,
+                retries=eng.retries, cells=int(g["active"].sum()), w_inlet=float(g["w"][inj]),
+                p_inlet=float(g["p"][inj]), injected=final.injected, stored=final.stored,
+                leaked=final.leaked, max_balance_error=eng.max_balance_error, **eng.front())

@@ -1,0 +1,32 @@
+"""Carter leak-off integrated exactly over a step (Eq. 29's C'/sqrt(t - tau) term)."""
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from hfgpu.fracture.leakoff import available_fraction, carter_volume
+
+
+@pytest.mark.parametrize("tau, t0, t1", [(0.0, 1.0, 3.0), (2.0, 1.0, 3.0), (0.5, 0.5, 0.6), (5.0, 1.0, 3.0)])
+def test_carter_volume_matches_quadrature_of_the_rate(tau, t0, t1):
+    c_prime = 3e-4
+    expected = quad(lambda t: c_prime / np.sqrt(t - tau), max(t0, tau), t1)[0] if t1 > tau else 0.0
+    assert carter_volume(np.array([c_prime]), np.array([tau]), t0, t1)[0] == pytest.approx(expected, rel=1e-7,
+                                                                                         abs=1e-15)
+
+
+def test_carter_volume_is_additive_over_sub_steps():
+    c_prime, tau = np.array([1e-3]), np.array([0.3])
+    edges = np.linspace(0.0, 7.0, 23)
+    parts = sum(carter_volume(c_prime, tau, a, b)[0] for a, b in zip(edges[:-1], edges[1:]))
+    assert parts == pytest.approx(2 * 1e-3 * np.sqrt(7.0 - 0.3), rel=1e-12)
+
+
+def test_available_fraction_is_a_monotone_ramp_from_zero_to_one():
+    w = np.array([-1e-6, 0.0, 1e-7, 5e-6, 1e-3])
+    g, dg = available_fraction(w, np.full(5, 1e-6))
+    assert g[1] == 0.0 and g[0] < 0.0 and np.all(np.diff(g) > 0)
+    assert g[3] == pytest.approx(1 - np.exp(-5)) and g[4] == pytest.approx(1.0)
+    h = 1e-12
+    fd = (available_fraction(w + h, np.full(5, 1e-6))[0] - available_fraction(w - h, np.full(5, 1e-6))[0]) / (2 * h)
+    np.testing.assert_allclose(dg, fd, rtol=1e-4)

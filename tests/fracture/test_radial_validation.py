@@ -1,0 +1,90 @@
+"""Radial fractures of the paper's Table 2 against Dontsov's (2016) universal radial solution and the
+vertex closed forms (Savitski & Detournay 2002; REFERENCE.md 1.1, 1.3), via hfgpu.reference.radial.
+
+Default runs are coarse (about 20-25 cells across the final diameter); tolerances reflect that. The
+refinement series and the 2 % (radius) / 5 % (inlet width) goals are marked slow.
+"""
+
+import dataclasses
+import math
+
+import pytest
+
+from hfgpu.fracture.simulator import simulate
+from hfgpu.reference.radial import dontsov_radial, k_vertex, m_vertex
+from hfgpu.scene import Mesh, load_scene
+
+from .helpers import SCENES, ListSink
+
+
+def run_case(name: str, cell: float | None = None, **numerics):
+    sc = load_scene(SCENES / f"radial_{name}.toml")
+    if cell is not None:
+        sc = sc.replace(mesh=Mesh(cell, cell))
+    if numerics:
+        sc = sc.replace(fracture=dataclasses.replace(sc.fracture, **numerics))
+    sink = ListSink()
+    out = simulate(sc, sink)
+    rock = sc.rock
+    e_prime, mu_prime = rock.plane_strain_modulus, 12 * sc.fluid.viscosity
+    k_prime, c_prime = math.sqrt(32 / math.pi) * rock.toughness, 2 * rock.leakoff_coefficient
+    q, t = sc.injection.schedule.stages[0].rate, sc.run.end_time
+    ref = dontsov_radial(e_prime, k_prime, mu_prime, c_prime, q, t)
+    errors = dict(R=out["radius"] / ref.R[-1] - 1, w0=out["w_inlet"] / ref.w0[-1] - 1,
+                  R_min=out["radius_min"] / ref.R[-1] - 1, R_max=out["radius_max"] / ref.R[-1] - 1)
+    return out, sink, errors, (e_prime, mu_prime, k_prime, q, t)
+
+
+def test_case_I_storage_viscosity_coarse():
+    out, sink, err, (e, mu, k, q, t) = run_case("I")            # 5 m cells, ~22 across
+    assert abs(err["R"]) < 0.06 and abs(err["w0"]) < 0.04, err
+    vertex = m_vertex(e, mu, q, t)                                 # the case sits at the M vertex
+    assert out["radius"] == pytest.approx(float(vertex.R), rel=0.06)
+    assert out["max_balance_error"] < 1e-3
+
+
+def test_case_III_storage_toughness_coarse():
+    out, sink, err, (e, mu, k, q, t) = run_case("III")          # 0.25 m cells, ~22 across
+    assert abs(err["R"]) < 0.02 and abs(err["w0"]) < 0.06, err
+    vertex = k_vertex(e, k, q, t)
+    assert out["w_inlet"] == pytest.approx(float(vertex.w0), rel=0.07)
+    assert out["max_balance_error"] < 1e-3
+
+
+def test_case_II_leakoff_viscosity_coarse():
+    # Known limitation (see report): whole-cell Carter leak-off in tip cells; the radius is ~12 % long.
+    out, sink, err, _ = run_case("II")
+    assert abs(err["R"]) < 0.15 and abs(err["w0"]) < 0.05, err
+    assert out["max_balance_error"] < 1e-3
+
+
+@pytest.mark.slow
+def test_case_I_refinement_reduces_the_radius_error():
+    errors = [run_case("I", cell)[2] for cell in (5.0, 3.5, 2.5)]
+    r = [abs(e["R"]) for e in errors]
+    assert r[0] > r[1] > r[2], errors
+    assert all(abs(e["w0"]) < 0.03 for e in errors), errors
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(reason="at 0.18 m cells Newton fails near t = 380 s after its step retries (K-regime "
+                          "stiffness; see report)", strict=False)
+def test_case_III_fine_meets_the_goal():
+    _, _, err, _ = run_case("III", 0.18)
+    assert abs(err["R"]) < 0.02 and abs(err["w0"]) < 0.05, err
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(reason="storage-viscosity radius converges slowly (+3.3 % at 2.5 m cells); 2 % needs "
+                          "a finer front model or finer cells than the dense solver affords", strict=False)
+def test_case_I_meets_the_goal():
+    _, _, err, _ = run_case("I", 2.5)
+    assert abs(err["R"]) < 0.02 and abs(err["w0"]) < 0.05, err
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(reason="leak-off cases: tip-cell leak-off is charged over whole cells", strict=False)
+@pytest.mark.parametrize("name", ["II", "IV"])
+def test_leakoff_cases_meet_the_goal(name):
+    _, _, err, _ = run_case(name)
+    assert abs(err["R"]) < 0.02 and abs(err["w0"]) < 0.05, err
