@@ -1,30 +1,42 @@
 """Taichi kernels of the MP-PIC particle operations; the NumPy references are in
-``hfgpu.proppant.particle_ops_numpy`` (same formulas, same order of operations; tests compare them).
+``hfgpu.proppant.particle_ops_numpy`` (same formulas, same order of operations up to round-off; tests compare
+them).
 
-Gather and push: one thread per parcel. Scatter and exchange: one task per CHUNK consecutive parcels, which
-sums runs of parcels sharing a stencil in registers and adds them to the grid with float64 atomics, so
-round-off differs from run to run and parcels sorted by cell (Parcels.sort_by_cell) need few atomics.
+Gather: one thread per parcel. Push: one task per LANES consecutive parcels; their drag solves (Eq. 43) run
+as LANES-wide vectors so that the independent dependency chains of the parcels interleave (one parcel's
+fixed-point iteration is a serial chain of log, exp, sqrt and divisions, latency-bound), then each parcel
+moves (Eq. 44, walls). Parcel positions enter the stencils as cell coordinates s = (x - x0) / dx, computed
+once per parcel and position (the same expression as ``interpolation.weights``). The push's powers
+theta_f^-2.65, theta_f^-1.78 and Re^0.687, Re^(2/3) are exp(a log b) with log theta_f shared: float64 ``pow``
+is about twice the cost of exp + log, and these libm calls bound the push.
+
+Scatter and exchange: the parcels are split into ``blocks`` ranges, one task each, which sum runs of parcels
+sharing a stencil in registers and add them to the grid copy ``out[copy]``. On the CPU (``private`` true)
+each block has its own copy, written without atomics, and the caller sums the copies: no atomics at all,
+results are deterministic, and random parcel order costs little more than sorted order. On a GPU
+(``private`` false) blocks are CHUNK parcels that add into one copy with float64 atomics (round-off then
+varies from run to run), and parcels sorted by cell (Parcels.sort_by_cell) need few atomics.
 All arrays are numpy arrays passed as ``ti.types.ndarray`` (zero copy on the CPU; copied to and from the
 device on a GPU, once per call).
 """
-
 
 from hfgpu.kernels.runtime import ti
 
 F1 = ti.types.ndarray(dtype=ti.f64, ndim=1)
 F2 = ti.types.ndarray(dtype=ti.f64, ndim=2)
-F3 = ti.types.ndarray(dtype=ti.f64, ndim=3)
+F4 = ti.types.ndarray(dtype=ti.f64, ndim=4)
 I1 = ti.types.ndarray(dtype=ti.i32, ndim=1)
 
 PI = 3.141592653589793
+CHUNK = 64  # parcels per block of the atomic (GPU) deposits
+SEEN = 11  # what a parcel sees, in the order of ParcelFluid: u_f, v_f, dp/dx, dp/dz, dtau/dx, dtau/dz,
+#            theta_p, <u>, <v>, 1/tau_D, width
 
 
 @ti.func
-def bilinear(x: ti.f64, z: ti.f64, ox: ti.f64, oz: ti.f64, x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64,
-             mask: ti.template()):
-    """Renormalised bilinear weights (Eq. 36-37) onto the active 2 x 2 nodes; see proppant/interpolation.py."""
-    sx = (x - x0) / dx - ox
-    sz = (z - z0) / dz - oz
+def bilinear(sx: ti.f64, sz: ti.f64, mask: ti.template()):
+    """Renormalised bilinear weights (Eq. 36-37) onto the active 2 x 2 nodes of ``mask`` at node coordinates
+    (sx, sz) = ((x - x0) / dx - ox, (z - z0) / dz - oz); see proppant/interpolation.py."""
     fi = ti.floor(sx)
     fk = ti.floor(sz)
     fx = sx - fi
@@ -62,11 +74,10 @@ def sample(field: ti.template(), k0: ti.i32, i0: ti.i32, w):
 
 
 @ti.func
-def owner_width(x: ti.f64, z: ti.f64, x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64,
-                width: ti.template()) -> ti.f64:
-    """Width of the cell containing (x, z); 0 outside the grid."""
-    i = ti.cast(ti.floor((x - x0) / dx + 0.5), ti.i32)
-    k = ti.cast(ti.floor((z - z0) / dz + 0.5), ti.i32)
+def owner_width(sx: ti.f64, sz: ti.f64, width: ti.template()) -> ti.f64:
+    """Width of the cell containing the point of cell coordinates (sx, sz); 0 outside the grid."""
+    i = ti.cast(ti.floor(sx + 0.5), ti.i32)
+    k = ti.cast(ti.floor(sz + 0.5), ti.i32)
     w = 0.0
     if k >= 0 and k < width.shape[0] and i >= 0 and i < width.shape[1]:
         w = width[k, i]
@@ -74,24 +85,54 @@ def owner_width(x: ti.f64, z: ti.f64, x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti
 
 
 @ti.func
-def blocked(x: ti.f64, z: ti.f64, xn: ti.f64, zn: ti.f64, x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64,
-            width: ti.template(), cell_mask: ti.template(), theta: ti.template(), theta_cp: ti.f64) -> ti.i32:
-    """The move (x, z) -> (xn, zn) leaves the grid, enters a closed cell, or raises the parcel's bilinear
-    weight on a cell with theta_p >= theta_cp (particle_ops_numpy._blocked)."""
+def blocked(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, width: ti.template(), cell_mask: ti.template(),
+            theta: ti.template(), theta_cp: ti.f64) -> ti.i32:
+    """The move (sx, sz) -> (sxn, szn) (cell coordinates) leaves the grid, enters a closed cell, or raises the
+    parcel's bilinear weight on a cell with theta_p >= theta_cp (particle_ops_numpy._blocked)."""
     out = 1
-    if owner_width(xn, zn, x0, z0, dx, dz, width) > 0.0:
+    if owner_width(sxn, szn, width) > 0.0:
         out = 0
-        if packed_near(xn, zn, x0, z0, dx, dz, theta, theta_cp):
-            out = packed_gain(x, z, xn, zn, x0, z0, dx, dz, cell_mask, theta, theta_cp)
+        if packed_near(sxn, szn, theta, theta_cp):
+            out = packed_gain(sx, sz, sxn, szn, cell_mask, theta, theta_cp)
+        if out == 0:
+            out = toward_wall_packed(sx, sz, sxn, szn, width, theta, theta_cp)
     return out
 
 
 @ti.func
-def packed_near(x: ti.f64, z: ti.f64, x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, theta: ti.template(),
-                theta_cp: ti.f64) -> ti.i32:
-    """Whether a cell of the 2 x 2 cell stencil of (x, z) has theta_p >= theta_cp (fast path of blocked)."""
-    i0 = ti.cast(ti.floor((x - x0) / dx), ti.i32)
-    k0 = ti.cast(ti.floor((z - z0) / dz), ti.i32)
+def closed(k: ti.i32, i: ti.i32, width: ti.template()) -> ti.i32:
+    """Cell (k, i) is outside the grid or closed."""
+    out = 1
+    if k >= 0 and k < width.shape[0] and i >= 0 and i < width.shape[1]:
+        out = ti.cast(width[k, i] <= 0.0, ti.i32)
+    return out
+
+
+@ti.func
+def toward_wall_packed(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, width: ti.template(),
+                       theta: ti.template(), theta_cp: ti.f64) -> ti.i32:
+    """The parcel's own cell is at close packing and it moves, within the half cell next to a wall (domain
+    edge or closed cell), towards that wall (particle_ops_numpy._toward_wall_packed). The sign of the move is
+    that of sxn - sx: cell coordinates are monotone in x, and differ wherever the move counts."""
+    out = 0
+    i = ti.cast(ti.floor(sx + 0.5), ti.i32)
+    k = ti.cast(ti.floor(sz + 0.5), ti.i32)
+    if k >= 0 and k < width.shape[0] and i >= 0 and i < width.shape[1]:
+        if theta[k, i] >= theta_cp:
+            fx = sx - i
+            fz = sz - k
+            if ti.abs(sxn - i) > ti.abs(fx) and fx * (sxn - sx) > 0.0:
+                out = closed(k, i + (1 if fx >= 0.0 else -1), width)
+            if ti.abs(szn - k) > ti.abs(fz) and fz * (szn - sz) > 0.0:
+                out = out | closed(k + (1 if fz >= 0.0 else -1), i, width)
+    return out
+
+
+@ti.func
+def packed_near(sx: ti.f64, sz: ti.f64, theta: ti.template(), theta_cp: ti.f64) -> ti.i32:
+    """Whether a cell of the 2 x 2 cell stencil of (sx, sz) has theta_p >= theta_cp (fast path of blocked)."""
+    i0 = ti.cast(ti.floor(sx), ti.i32)
+    k0 = ti.cast(ti.floor(sz), ti.i32)
     found = 0
     for a in ti.static(range(2)):
         for b in ti.static(range(2)):
@@ -102,12 +143,12 @@ def packed_near(x: ti.f64, z: ti.f64, x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti
 
 
 @ti.func
-def packed_gain(x: ti.f64, z: ti.f64, xn: ti.f64, zn: ti.f64, x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64,
-                cell_mask: ti.template(), theta: ti.template(), theta_cp: ti.f64) -> ti.i32:
+def packed_gain(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cell_mask: ti.template(), theta: ti.template(),
+                theta_cp: ti.f64) -> ti.i32:
     """Whether the move raises the parcel's bilinear weight on a cell with theta_p >= theta_cp."""
     out = 0
-    k0, i0, w0 = bilinear(x, z, 0.0, 0.0, x0, z0, dx, dz, cell_mask)
-    k1, i1, w1 = bilinear(xn, zn, 0.0, 0.0, x0, z0, dx, dz, cell_mask)
+    k0, i0, w0 = bilinear(sx, sz, cell_mask)
+    k1, i1, w1 = bilinear(sxn, szn, cell_mask)
     for a in ti.static(range(2)):
         for b in ti.static(range(2)):
             if w1[2 * a + b] > 0.0:
@@ -122,38 +163,57 @@ def packed_gain(x: ti.f64, z: ti.f64, xn: ti.f64, zn: ti.f64, x0: ti.f64, z0: ti
     return out
 
 
-CHUNK = 64  # parcels per thread task in the deposits; runs of parcels sharing a stencil are summed locally
-
-
 @ti.func
-def flush(out: ti.template(), k0: ti.i32, i0: ti.i32, acc: ti.template(), nch: ti.template()):
-    """Atomic add of the locally summed 2 x 2 x nch block acc onto out (nz, nx, channels) at base (k0, i0);
-    blocks that sum to exactly 0 (every node outside the grid or inactive carries 0) are skipped."""
+def flush(out: ti.template(), copy: ti.i32, k0: ti.i32, i0: ti.i32, acc: ti.template(), nch: ti.template(),
+          private: ti.template()):
+    """Add the locally summed 2 x 2 x nch block acc onto out[copy] (copies, nz, nx, channels) at base (k0, i0):
+    plainly where the copy is private to this task, else with atomics; blocks that sum to exactly 0 (every
+    node outside the grid or inactive carries 0) are skipped."""
     for a in ti.static(range(2)):
         for b in ti.static(range(2)):
             for c in ti.static(range(nch)):
                 if acc[2 * a + b, c] != 0.0:
-                    ti.atomic_add(out[k0 + a, i0 + b, c], acc[2 * a + b, c])
+                    if ti.static(private):
+                        out[copy, k0 + a, i0 + b, c] = out[copy, k0 + a, i0 + b, c] + acc[2 * a + b, c]
+                    else:
+                        ti.atomic_add(out[copy, k0 + a, i0 + b, c], acc[2 * a + b, c])
+
+
+@ti.func
+def block_range(block: ti.i32, blocks: ti.i32, n: ti.i32, private: ti.template()):
+    """Parcels [start, end) of a deposit block: ``blocks`` near-equal ranges (private copies) or CHUNK."""
+    start = ti.cast(0, ti.i32)
+    end = ti.cast(0, ti.i32)
+    if ti.static(private):
+        start = ti.cast(ti.cast(n, ti.i64) * block // blocks, ti.i32)
+        end = ti.cast(ti.cast(n, ti.i64) * (block + 1) // blocks, ti.i32)
+    else:
+        start = ti.cast(block * CHUNK, ti.i32)
+        end = ti.cast(ti.min(n, start + CHUNK), ti.i32)
+    return start, end
 
 
 @ti.kernel
 def moment_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles: F1,
-                x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, cell_mask: F2, out: F3):
-    """Bilinear sums of volume, mass, mass u, mass v, mass |u|^2, n r^3, n r^2 (Eq. 38) into out (nz, nx, 7)
-    (channel last: a node's sums share a cache line), which the caller zeroes.
+                x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, cell_mask: F2, blocks: ti.i32,
+                private: ti.template(), out: F4):
+    """Bilinear sums of volume, mass, mass u, mass v, mass |u|^2, n r^3, n r^2 (Eq. 38) into out (copies, nz,
+    nx, 7) (channel last: a node's sums share a cache line), which the caller zeroes and sums over copies.
 
-    Each task walks CHUNK consecutive parcels and sums in registers while the stencil base stays the same,
-    so parcels sorted by cell (Parcels.sort_by_cell) need few atomics; any order gives the same sums."""
+    Each block walks its parcels and sums in registers while the stencil base stays the same, so parcels
+    sorted by cell (Parcels.sort_by_cell) flush rarely; any order gives the same sums up to round-off."""
     n = ti.cast(x.shape[0], ti.i32)
-    for chunk in range(ti.cast((n + CHUNK - 1) // CHUNK, ti.i32)):
+    for block in range(blocks):
+        copy = block if ti.static(private) else 0
+        start, end = block_range(block, blocks, n, private)
         acc = ti.Matrix.zero(ti.f64, 4, 7)
         kb = -1
         ib = -1
-        for p in range(ti.cast(chunk * CHUNK, ti.i32), ti.cast(ti.min(n, (chunk + 1) * CHUNK), ti.i32)):
-            k0, i0, w = bilinear(x[p], z[p], 0.0, 0.0, x0, z0, dx, dz, cell_mask)
+        for p in range(start, end):
+            k0, i0, w = bilinear((x[p] - x0) / dx, (z[p] - z0) / dz, cell_mask)
             if k0 != kb or i0 != ib:
                 if kb != -1 or ib != -1:
-                    flush(out, kb, ib, acc, 7)
+                    flush(out, copy, kb, ib, acc, 7, private)
                 acc = ti.Matrix.zero(ti.f64, 4, 7)
                 kb = k0
                 ib = i0
@@ -166,60 +226,141 @@ def moment_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles: 
                 for c in ti.static(range(7)):
                     acc[j, c] += vals[c] * w[j]
         if kb != -1 or ib != -1:
-            flush(out, kb, ib, acc, 7)
+            flush(out, copy, kb, ib, acc, 7, private)
+
+
+@ti.func
+def seen_at(sx: ti.f64, sz: ti.f64, cell_mask: ti.template(), xface_mask: ti.template(),
+            zface_mask: ti.template(), fluid_u: ti.template(), fluid_v: ti.template(), dpdx: ti.template(),
+            dpdz: ti.template(), dtaudx: ti.template(), dtaudz: ti.template(), theta: ti.template(),
+            mean_u: ti.template(), mean_v: ti.template(), damping: ti.template(), width: ti.template()):
+    """The SEEN grid values at cell coordinates (sx, sz) (Eq. 40-41 with x-/z-face weights; cell fields with
+    cell weights; the width of the own cell)."""
+    kx, ix, wx = bilinear(sx + 0.5, sz, xface_mask)
+    kz, iz, wz = bilinear(sx, sz + 0.5, zface_mask)
+    kc, ic, wc = bilinear(sx, sz, cell_mask)
+    return ti.Vector([sample(fluid_u, kx, ix, wx), sample(fluid_v, kz, iz, wz),
+                      sample(dpdx, kx, ix, wx), sample(dpdz, kz, iz, wz),
+                      sample(dtaudx, kx, ix, wx), sample(dtaudz, kz, iz, wz),
+                      sample(theta, kc, ic, wc), sample(mean_u, kc, ic, wc), sample(mean_v, kc, ic, wc),
+                      sample(damping, kc, ic, wc), owner_width(sx, sz, width)], dt=ti.f64)
 
 
 @ti.kernel
 def gather(x: F1, z: F1, x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64,
            cell_mask: F2, xface_mask: F2, zface_mask: F2,
            fluid_u: F2, fluid_v: F2, dpdx: F2, dpdz: F2, dtaudx: F2, dtaudz: F2,
-           theta: F2, mean_u: F2, mean_v: F2, damping: F2, width: F2,
-           o_u: F1, o_v: F1, o_dpdx: F1, o_dpdz: F1, o_dtaudx: F1, o_dtaudz: F1,
-           o_theta: F1, o_mean_u: F1, o_mean_v: F1, o_damping: F1, o_width: F1):
-    """Grid fields at the parcels (Eq. 40-41 with x-/z-face weights; cell fields with cell weights)."""
+           theta: F2, mean_u: F2, mean_v: F2, damping: F2, width: F2, seen: F2):
+    """Grid fields at the parcels (Eq. 40-41) into seen (SEEN, n), rows in the order of ParcelFluid."""
     for p in x:
-        kx, ix, wx = bilinear(x[p], z[p], -0.5, 0.0, x0, z0, dx, dz, xface_mask)
-        kz, iz, wz = bilinear(x[p], z[p], 0.0, -0.5, x0, z0, dx, dz, zface_mask)
-        kc, ic, wc = bilinear(x[p], z[p], 0.0, 0.0, x0, z0, dx, dz, cell_mask)
-        o_u[p] = sample(fluid_u, kx, ix, wx)
-        o_dpdx[p] = sample(dpdx, kx, ix, wx)
-        o_dtaudx[p] = sample(dtaudx, kx, ix, wx)
-        o_v[p] = sample(fluid_v, kz, iz, wz)
-        o_dpdz[p] = sample(dpdz, kz, iz, wz)
-        o_dtaudz[p] = sample(dtaudz, kz, iz, wz)
-        o_theta[p] = sample(theta, kc, ic, wc)
-        o_mean_u[p] = sample(mean_u, kc, ic, wc)
-        o_mean_v[p] = sample(mean_v, kc, ic, wc)
-        o_damping[p] = sample(damping, kc, ic, wc)
-        o_width[p] = owner_width(x[p], z[p], x0, z0, dx, dz, width)
+        s = seen_at((x[p] - x0) / dx, (z[p] - z0) / dz, cell_mask, xface_mask, zface_mask, fluid_u, fluid_v,
+                    dpdx, dpdz, dtaudx, dtaudz, theta, mean_u, mean_v, damping, width)
+        for j in ti.static(range(SEEN)):
+            seen[j, p] = s[j]
+
+
+LANES = 4  # parcels per push task: their independent drag solves interleave (the solve is latency-bound)
 
 
 @ti.func
-def drag_rate(slip: ti.f64, r: ti.f64, rho_p: ti.f64, rho_f: ti.f64, mu: ti.f64, hinder: ti.f64,
-              hinder_snider: ti.f64, law: ti.i32, re_coefficient: ti.f64) -> ti.f64:
-    """D_p = 4.5 mu / (rho_p r^2) x C_d Re / 24 (Eq. 13-15; closures.drag_rate), with the crowding powers
-    hinder = theta_f^-2.65 and hinder_snider = theta_f^-1.78 computed once per parcel by the caller."""
-    re = 2.0 * rho_f * ti.abs(slip) * r / mu
-    factor = 0.0
-    if law == 1:
-        factor = hinder + re ** (2.0 / 3.0) * hinder_snider / 6.0
-    elif re < 1000.0:
-        factor = hinder * (1.0 + re_coefficient * re ** 0.687)
-    else:
-        factor = hinder * (0.44 * re / 24.0)
-    return 4.5 * mu / (rho_p * r ** 2) * factor
+def power(base, exponent: ti.template()):
+    """base^exponent for base >= 0 (elementwise) as exp(exponent log base), 0 at base 0: about half the cost
+    of float64 pow."""
+    positive = base > 0.0
+    return ti.select(positive, ti.exp(exponent * ti.log(ti.select(positive, base, 1.0))), 0.0)
 
 
 @ti.func
-def limited(delta: ti.f64, slip: ti.f64, grad: ti.f64, restitution: ti.f64) -> ti.f64:
-    """Snider (2001) eqs. 39-41 packing limiter of the stress velocity (particle_ops_numpy)."""
+def limited(delta, slip, grad, restitution: ti.f64):
+    """Snider (2001) eqs. 39-41 packing limiter of the stress velocity (particle_ops_numpy), elementwise."""
     bound = (1.0 + restitution) * slip
-    out = 0.0
-    if grad <= 0.0:
-        out = ti.max(ti.min(delta, bound), 0.0)
-    else:
-        out = ti.min(ti.max(delta, bound), 0.0)
-    return out
+    return ti.select(grad <= 0.0, ti.max(ti.min(delta, bound), 0.0), ti.min(ti.max(delta, bound), 0.0))
+
+
+@ti.func
+def lanes(arr: ti.template(), p0: ti.i32, n: ti.i32):
+    """arr at the LANES parcels p0, p0 + 1, ... (the last parcel repeated past n)."""
+    return ti.Vector([arr[ti.min(p0 + l, n - 1)] for l in ti.static(range(LANES))], dt=ti.f64)
+
+
+@ti.func
+def velocity_lanes(p0: ti.i32, n: ti.i32, u: ti.template(), v: ti.template(), radius: ti.template(),
+                   density: ti.template(), s_u: ti.template(), s_v: ti.template(), s_dpdx: ti.template(),
+                   s_dpdz: ti.template(), s_dtaudx: ti.template(), s_dtaudz: ti.template(),
+                   s_theta: ti.template(), s_mean_u: ti.template(), s_mean_v: ti.template(),
+                   s_damping: ti.template(), s_width: ti.template(), dt: ti.f64, rho_f: ti.f64, mu: ti.f64,
+                   gravity: ti.f64, theta_cp: ti.f64, epsilon: ti.f64, restitution: ti.f64, law: ti.i32,
+                   re_coefficient: ti.f64, bridging_factor: ti.f64, iterations: ti.i32):
+    """New velocities (Eq. 43 with the packing limiter and bridging of particle_ops_numpy.push), D_p of the
+    last drag solve and the bridged flags of the LANES parcels p0, p0 + 1, ... (vectors; lanes past n repeat
+    the last parcel).
+
+    D_p = 4.5 mu / (rho_p r^2) x C_d Re / 24 (Eq. 13-15, closures.drag_rate): law 0 Eq. 14 (theta_f^-2.65
+    (1 + c Re^0.687) below Re = 1000, else 0.44 Re / 24 theta_f^-2.65), law 1 Snider (2001)."""
+    rho_p = lanes(density, p0, n)
+    r = lanes(radius, p0, n)
+    u0 = lanes(u, p0, n)
+    v0 = lanes(v, p0, n)
+    uf = lanes(s_u, p0, n)
+    vf = lanes(s_v, p0, n)
+    dpdx = lanes(s_dpdx, p0, n)
+    dpdz = lanes(s_dpdz, p0, n)
+    theta = lanes(s_theta, p0, n)
+    mean_u = lanes(s_mean_u, p0, n)
+    mean_v = lanes(s_mean_v, p0, n)
+    half_rate = 0.5 * lanes(s_damping, p0, n)
+    buoyant_g = (1.0 - rho_f / rho_p) * gravity
+    log_tf = ti.log(1.0 - ti.min(theta, theta_cp))  # theta_f of closures.fluid_fraction
+    hinder = ti.exp(-2.65 * log_tf)
+    hinder_snider = hinder * 0.0
+    if law == 1:
+        hinder_snider = ti.exp(-1.78 * log_tf)
+    stokes = 4.5 * mu / (rho_p * (r * r))
+    re_per_slip = 2.0 * rho_f * r / mu
+    un = u0
+    vn = v0
+    drag = u0 * 0.0
+    den = drag + 1.0
+    for _ in range(iterations):
+        re = re_per_slip * ti.sqrt((uf - un) ** 2 + (vf - vn) ** 2)
+        factor = hinder
+        if law == 1:
+            factor = hinder + power(re, 2.0 / 3.0) * hinder_snider / 6.0
+        else:
+            factor = hinder * ti.select(re < 1000.0, 1.0 + re_coefficient * power(re, 0.687), 0.44 * re / 24.0)
+        drag = stokes * factor
+        den = 1.0 + dt * (drag + half_rate)
+        un = (u0 + dt * (drag * uf - dpdx / rho_p + half_rate * mean_u)) / den
+        vn = (v0 + dt * (drag * vf - dpdz / rho_p + buoyant_g + half_rate * mean_v)) / den
+    scale = -dt / (ti.max(theta, epsilon) * rho_p * den)
+    gx = lanes(s_dtaudx, p0, n)
+    gz = lanes(s_dtaudz, p0, n)
+    un = un + limited(scale * gx, mean_u - un, gx, restitution)
+    vn = vn + limited(scale * gz, mean_v - vn, gz, restitution)
+    bridged = lanes(s_width, p0, n) < bridging_factor * 2.0 * r
+    return ti.select(bridged, 0.0, un), ti.select(bridged, 0.0, vn), drag, bridged
+
+
+@ti.func
+def move(p: ti.i32, x: ti.template(), z: ti.template(), u: ti.template(), v: ti.template(), x0: ti.f64,
+         z0: ti.f64, dx: ti.f64, dz: ti.f64, dt: ti.f64, width: ti.template(), cell_mask: ti.template(),
+         theta_grid: ti.template(), theta_cp: ti.f64):
+    """Eq. 44 for parcel p with its new velocity (u[p], v[p]), x first, then z; a move that blocked() stops is
+    cancelled and that velocity component set to 0 (particle_ops_numpy.push)."""
+    sx = (x[p] - x0) / dx
+    sz = (z[p] - z0) / dz
+    xn = x[p] + dt * u[p]
+    sxn = (xn - x0) / dx
+    if blocked(sx, sz, sxn, sz, width, cell_mask, theta_grid, theta_cp):
+        xn = x[p]
+        sxn = sx
+        u[p] = 0.0
+    zn = z[p] + dt * v[p]
+    if blocked(sxn, sz, sxn, (zn - z0) / dz, width, cell_mask, theta_grid, theta_cp):
+        zn = z[p]
+        v[p] = 0.0
+    x[p] = xn
+    z[p] = zn
 
 
 @ti.kernel
@@ -230,79 +371,71 @@ def push(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, state: I1,
          dt: ti.f64, rho_f: ti.f64, mu: ti.f64, gravity: ti.f64,
          theta_cp: ti.f64, epsilon: ti.f64, restitution: ti.f64, law: ti.i32, re_coefficient: ti.f64,
          bridging_factor: ti.f64, iterations: ti.i32, drag_out: F1):
-    """Eq. 43-44 with the packing limiter and cap, walls and bridging of particle_ops_numpy.push, in place."""
-    for p in x:
-        rho_p = density[p]
-        theta = s_theta[p]
-        half_rate = 0.5 * s_damping[p]
-        buoyant_g = (1.0 - rho_f / rho_p) * gravity
-        un = u[p]
-        vn = v[p]
-        theta_f = 1.0 - ti.min(theta, theta_cp)
-        hinder = theta_f ** -2.65
-        hinder_snider = 0.0
-        if law == 1:
-            hinder_snider = theta_f ** -1.78
-        drag = 0.0
-        den = 1.0
-        for _ in range(iterations):
-            slip = ti.sqrt((s_u[p] - un) ** 2 + (s_v[p] - vn) ** 2)
-            drag = drag_rate(slip, radius[p], rho_p, rho_f, mu, hinder, hinder_snider, law, re_coefficient)
-            den = 1.0 + dt * (drag + half_rate)
-            un = (u[p] + dt * (drag * s_u[p] - s_dpdx[p] / rho_p + half_rate * s_mean_u[p])) / den
-            vn = (v[p] + dt * (drag * s_v[p] - s_dpdz[p] / rho_p + buoyant_g + half_rate * s_mean_v[p])) / den
-        scale = -dt / (ti.max(theta, epsilon) * rho_p * den)
-        un = un + limited(scale * s_dtaudx[p], s_mean_u[p] - un, s_dtaudx[p], restitution)
-        vn = vn + limited(scale * s_dtaudz[p], s_mean_v[p] - vn, s_dtaudz[p], restitution)
-        bridged = s_width[p] < bridging_factor * 2.0 * radius[p]
-        if bridged:
-            un = 0.0
-            vn = 0.0
-        xn = x[p] + dt * un
-        if blocked(x[p], z[p], xn, z[p], x0, z0, dx, dz, width, cell_mask, theta_grid, theta_cp):
-            xn = x[p]
-            un = 0.0
-        zn = z[p] + dt * vn
-        if blocked(xn, z[p], xn, zn, x0, z0, dx, dz, width, cell_mask, theta_grid, theta_cp):
-            zn = z[p]
-            vn = 0.0
-        x[p] = xn
-        z[p] = zn
-        u[p] = un
-        v[p] = vn
-        state[p] = ti.cast(1 if bridged else 0, ti.i32)
-        drag_out[p] = drag
+    """Eq. 43-44 in place with what the parcels see (s_*, the rows of ParcelFluid); D_p into drag_out.
+    One task per LANES parcels: velocity_lanes, then move for each."""
+    n = ti.cast(x.shape[0], ti.i32)
+    for q in range(ti.cast((n + LANES - 1) // LANES, ti.i32)):
+        p0 = ti.cast(q * LANES, ti.i32)
+        un, vn, drag, bridged = velocity_lanes(p0, n, u, v, radius, density, s_u, s_v, s_dpdx, s_dpdz, s_dtaudx,
+                                               s_dtaudz, s_theta, s_mean_u, s_mean_v, s_damping, s_width, dt,
+                                               rho_f, mu, gravity, theta_cp, epsilon, restitution, law,
+                                               re_coefficient, bridging_factor, iterations)
+        for l in ti.static(range(LANES)):
+            if p0 + l < n:
+                u[p0 + l] = un[l]
+                v[p0 + l] = vn[l]
+                drag_out[p0 + l] = drag[l]
+                state[p0 + l] = ti.cast(bridged[l], ti.i32)
+        for p in range(p0, ti.cast(ti.min(p0 + LANES, n), ti.i32)):
+            move(p, x, z, u, v, x0, z0, dx, dz, dt, width, cell_mask, theta_grid, theta_cp)
+
+
+@ti.func
+def face_force(along_x: ti.template(), p: ti.i32, u: ti.template(), v: ti.template(), radius: ti.template(),
+               density: ti.template(), particles: ti.template(), s_u: ti.template(), s_v: ti.template(),
+               s_dpdx: ti.template(), s_dpdz: ti.template(), drag: ti.template()) -> ti.f64:
+    """n rho_p V_p [D (u_f - u_p) - grad p / rho_p] of parcel p along x or z (numerator of Eq. 39)."""
+    vol = particles[p] * (4.0 / 3.0 * PI * radius[p] ** 3)
+    mass = vol * density[p]
+    f = 0.0
+    if ti.static(along_x):
+        f = mass * drag[p] * (s_u[p] - u[p]) - vol * s_dpdx[p]
+    else:
+        f = mass * drag[p] * (s_v[p] - v[p]) - vol * s_dpdz[p]
+    return f
 
 
 @ti.kernel
 def exchange_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles: F1,
                   s_u: F1, s_v: F1, s_dpdx: F1, s_dpdz: F1, drag: F1,
-                  x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, mask: F2, ox: ti.f64, oz: ti.f64,
-                  along_x: ti.i32, out: F3):
+                  x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, mask: F2, along_x: ti.template(),
+                  blocks: ti.i32, private: ti.template(), out: F4):
     """Face sums of n rho_p V_p [D (u_f - u_p) - grad p / rho_p] I (numerators of Eq. 39) for x-faces
-    (along_x = 1, ox = -1/2) or z-faces (along_x = 0, oz = -1/2) into out (faces, 1), zeroed by the caller;
-    run-local summation as in moment_sums."""
+    (along_x, mask (nz, nx+1)) or z-faces (mask (nz+1, nx)) into out (copies, faces..., 1), zeroed by the
+    caller and summed over copies; run-local summation and blocks as in moment_sums."""
     n = ti.cast(x.shape[0], ti.i32)
-    for chunk in range(ti.cast((n + CHUNK - 1) // CHUNK, ti.i32)):
+    for block in range(blocks):
+        copy = block if ti.static(private) else 0
+        start, end = block_range(block, blocks, n, private)
         acc = ti.Matrix.zero(ti.f64, 4, 1)
         kb = -1
         ib = -1
-        for p in range(ti.cast(chunk * CHUNK, ti.i32), ti.cast(ti.min(n, (chunk + 1) * CHUNK), ti.i32)):
-            k0, i0, w = bilinear(x[p], z[p], ox, oz, x0, z0, dx, dz, mask)
+        for p in range(start, end):
+            sx = (x[p] - x0) / dx
+            sz = (z[p] - z0) / dz
+            if ti.static(along_x):
+                sx += 0.5
+            else:
+                sz += 0.5
+            k0, i0, w = bilinear(sx, sz, mask)
             if k0 != kb or i0 != ib:
                 if kb != -1 or ib != -1:
-                    flush(out, kb, ib, acc, 1)
+                    flush(out, copy, kb, ib, acc, 1, private)
                 acc = ti.Matrix.zero(ti.f64, 4, 1)
                 kb = k0
                 ib = i0
-            vol = particles[p] * (4.0 / 3.0 * PI * radius[p] ** 3)
-            mass = vol * density[p]
-            f = 0.0
-            if along_x == 1:
-                f = mass * drag[p] * (s_u[p] - u[p]) - vol * s_dpdx[p]
-            else:
-                f = mass * drag[p] * (s_v[p] - v[p]) - vol * s_dpdz[p]
+            f = face_force(along_x, p, u, v, radius, density, particles, s_u, s_v, s_dpdx, s_dpdz, drag)
             for j in ti.static(range(4)):
                 acc[j, 0] += f * w[j]
         if kb != -1 or ib != -1:
-            flush(out, kb, ib, acc, 1)
+            flush(out, copy, kb, ib, acc, 1, private)
