@@ -95,8 +95,9 @@ def damping_rate(theta_p, velocity_variance, sauter_radius, params: MppicParams)
 
 def slurry_viscosity(theta_p, fluid_viscosity, params: MppicParams):
     """Slurry viscosity [Pa s] for the fluid phase: "power" mu_o (1 - theta_p/theta_cp)^n (Eq. 10, Barree &
-    Conway, n = -1.82) or "krieger-dougherty" mu_o (1 - theta_p/theta_cp)^(-2.5 theta_cp); the base is floored at
-    epsilon so that the value stays finite at and beyond close packing."""
+    Conway, n = -1.82) or "krieger-dougherty" mu_o (1 - theta_p/theta_cp)^(-2.5 theta_cp), capped at
+    max_relative_viscosity x mu_o (see MppicParams) so that it stays finite at and beyond close packing."""
     theta_p = np.asarray(theta_p, dtype=np.float64)
     exponent = params.viscosity_exponent if params.viscosity_law == "power" else -2.5 * params.theta_cp
-    return fluid_viscosity * np.maximum(1.0 - theta_p / params.theta_cp, params.epsilon) ** exponent
+    base = np.maximum(1.0 - theta_p / params.theta_cp, params.max_relative_viscosity ** (1.0 / exponent))
+    return fluid_viscosity * base ** exponent

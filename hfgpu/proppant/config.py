@@ -100,8 +100,12 @@ class MppicNumerics:
     simple_tolerance / simple_max_iterations: Algorithm 1 stopping rule (relative |p'|).
     gravity [m/s^2] acts along +depth.
     slurry_viscosity: the fluid phase uses the slurry viscosity of Eq. 10 (MppicParams.viscosity_law); false
-    uses the clean-fluid viscosity. Eq. 10 diverges at close packing, and the fluid step's explicit in-plane
-    diffusion is then unstable in a packed bed, so scenes that build a bed turn it off for now.
+    uses the clean-fluid viscosity. Eq. 10 diverges at close packing; the momentum predictor takes the
+    in-plane diffusion and wall friction implicitly and MppicParams.max_relative_viscosity caps mu_f / mu_0,
+    so it is on by default (the fluid of a packed bed is then held by its wall friction, Eq. 9). Known limit:
+    that friction acts on the fluid velocity, not on the mixture's, so it also resists the fluid a growing bed
+    expels through its top (Darcy flow, already in the drag); in a slow viscous sedimentation (the hindered-
+    settling scene, theta_0 = 0.2) the pressure this builds lifts the suspension, and that scene turns it off.
     """
 
     backend: str = "taichi"
@@ -135,7 +139,13 @@ class ProppantSetup:
 
 def parse_proppant_setup(top: Table, run: Any, fluid: Any, mesh: Any) -> ProppantSetup:
     """Read ``[geometry]``, ``[[proppant]]`` and ``[mppic]`` from the scene's top table."""
-    geometry = _parse_geometry(top.table("geometry"))
+    if "fracture" in run.physics:  # coupled: grid and annular inlet come from the fracture (hfgpu.coupled)
+        if top.has("geometry"):
+            raise SceneError("geometry", "(table)", 'leave [geometry] out when run.physics has "fracture": the '
+                             "proppant grid follows the fracture ([coupling] sets cell size and inlet ring)")
+        geometry = Geometry(kind="fracture", length=0.0, height=0.0)
+    else:
+        geometry = _parse_geometry(top.table("geometry"))
     classes = _parse_classes(top)
     numerics, params = _parse_mppic(top.table("mppic", {}))
     if geometry.kind == "field":

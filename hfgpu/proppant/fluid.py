@@ -96,8 +96,9 @@ class StepInfo:
     continuity_residual: max |Eq. 25 imbalance| over the cells where continuity is solved [m^3/s];
     courant: Eq. 42 with the new velocities and this dt (compare with c_max before accepting a step);
     volumes over the step [m^3]: injected (sources), leaked (s_l dA dt), outflow (through outlet cells),
-    stored (change of fluid volume theta_f w dA in open cells), dropped (fluid in cells that closed).
-    Balance: injected = stored + leaked + outflow to round-off.
+    stored (change of fluid volume theta_f w dA in open cells), dropped (fluid in cells that closed), opened
+    (fluid theta_f w dA placed in cells that opened during the step: a storage source, see FluidSolver.step).
+    Balance: injected + opened = stored + leaked + outflow to round-off.
     """
 
     iterations: int
@@ -109,6 +110,7 @@ class StepInfo:
     outflow: float
     stored: float
     dropped: float
+    opened: float
 
 
 class CourantLimitExceeded(SimulationError):
@@ -249,6 +251,12 @@ class FluidSolver:
         active = grid.active
         q_new = np.where(active, theta_f * grid.width, 0.0)
         q_old = np.where(state.width > 0.0, state.theta_f * state.width, 0.0)
+        # A cell that opens during the step (a growing fracture) is filled by the fracture's own flow, which the
+        # proppant grid does not resolve: its fluid theta_f w dA is a storage source (q_old = q_new, no storage
+        # term in Eq. 25) instead of being drawn through its faces within dt (that flux ~ 1/dt broke Eq. 42
+        # however small the step).
+        opened = active & ~(state.width > 0.0)
+        q_old = np.where(opened, q_new, q_old)
         q_u = face_mean(theta_f * grid.width, active, axis=1)
         q_v = face_mean(theta_f * grid.width, active, axis=0)
         fixed_rate = (np.where(active, q_new - q_old, 0.0) * grid.cell_area / dt
@@ -299,8 +307,10 @@ class FluidSolver:
             injected=float(np.sum(sources)) * dt,
             leaked=float(np.sum(leakoff)) * grid.cell_area * dt,
             outflow=-float(np.sum(imbalance[outlet])) * dt,
-            stored=float(np.sum(np.where(active, q_new - q_old, 0.0))) * grid.cell_area,
-            dropped=float(np.sum(np.where(active, 0.0, q_old))) * grid.cell_area)
+            stored=float(np.sum(np.where(active, q_new - q_old, 0.0)) + np.sum(np.where(opened, q_new, 0.0)))
+            * grid.cell_area,
+            dropped=float(np.sum(np.where(active, 0.0, q_old))) * grid.cell_area,
+            opened=float(np.sum(np.where(opened, q_new, 0.0))) * grid.cell_area)
         state.u, state.v, state.p = u, v, p
         state.theta_f, state.width = theta_f, grid.width.copy()
         return info

@@ -21,6 +21,12 @@ class MppicParams:
     C_d = 24/Re (theta_f^-2.65 + Re^(2/3) theta_f^-1.78 / 6) (REFERENCE.md 6.2).
     viscosity_law: slurry viscosity for the fluid: "power" = Eq. 10 with ``viscosity_exponent`` (-1.82),
     "krieger-dougherty" = (1 - theta/theta_cp)^(-2.5 theta_cp).
+    max_relative_viscosity: cap on mu_f / mu_0 of the slurry viscosity (both laws diverge at close packing).
+    A numerical regularisation, not a material constant: it only has to make the fluid of a packed bed
+    effectively immobile (its wall friction 12 mu_f / (rho_f w^2), Eq. 9, then stops it within a fraction
+    of a fluid step) while keeping the pressure-correction equation well conditioned (a face coefficient
+    d ~ 1/mu_f; beyond ~1e4 the pressure needed to squeeze fluid out of a compacting bed kicks the
+    parcels). Default 1000, reached at theta_p = 0.977 theta_cp by Eq. 10.
     bridging_factor: a parcel stops where the width of its cell < bridging_factor x its diameter. Default 2:
     the lower end of the 2-3 diameters commonly quoted for bridging of a particle stream in a slot
     (van der Vlis et al. 1975; Gruesbeck & Collins 1982), lower so that parcels are not stopped early.
@@ -40,6 +46,7 @@ class MppicParams:
     drag_re_coefficient: float = 0.15
     viscosity_law: str = "power"
     viscosity_exponent: float = -1.82
+    max_relative_viscosity: float = 1000.0
     bridging_factor: float = 2.0
     drag_iterations: int = 3
     packing_restitution: float = 0.0
@@ -67,6 +74,8 @@ class MppicParams:
             raise bad("viscosity_law", f"allowed: one of {list(VISCOSITY_LAWS)}")
         if not self.viscosity_exponent < 0.0:
             raise bad("viscosity_exponent", "allowed: a number < 0 (viscosity grows with theta_p)")
+        if not self.max_relative_viscosity >= 1.0:
+            raise bad("max_relative_viscosity", "allowed: a number >= 1")
         if isinstance(self.drag_iterations, bool) or not isinstance(self.drag_iterations, int) \
                 or self.drag_iterations < 1:
             raise bad("drag_iterations", "allowed: an integer >= 1")

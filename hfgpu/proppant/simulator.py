@@ -45,6 +45,9 @@ from .injection import Injector, batch_solid_volume, initial_suspension, ports_t
 from .parcels import Parcels
 from .particle_ops_numpy import ParcelFluid, grid_fields
 
+#: fluid volumes [m^3] the fluid step reports (hfgpu.proppant.fluid.StepInfo), summed in fluid_totals
+FLUID_VOLUMES = ("injected", "opened", "stored", "leaked", "outflow", "dropped")
+
 WidthField = Callable[[float], "tuple[np.ndarray, np.ndarray]"]
 
 
@@ -101,7 +104,8 @@ class ProppantSimulation:
     """State and stepping of one MP-PIC run; :func:`simulate` drives it to the end time.
 
     Attributes a caller may read: ``time``, ``grid``, ``parcels`` (:class:`Parcels`), ``fluid`` (the fluid
-    solver's state), ``injected``, ``outflow`` [m^3]. ``add_parcels`` places extra parcels (counted as
+    solver's state), ``injected``, ``outflow`` [m^3] (solids), ``fluid_totals`` (the fluid volumes of
+    FLUID_VOLUMES summed over the steps; injected + opened = stored + leaked + outflow). ``add_parcels`` places extra parcels (counted as
     injected), e.g. a single test particle.
     """
 
@@ -144,6 +148,7 @@ class ProppantSimulation:
         self.fluid = self.solver.initial_state(self._fluid_theta_p())
         self.steps = 0
         self.safety = 1.0
+        self.fluid_totals = dict.fromkeys(FLUID_VOLUMES, 0.0)
 
     # -- set-up ---------------------------------------------------------------------------------------
 
@@ -219,6 +224,8 @@ class ProppantSimulation:
             raise SimulationError(f"the fluid Courant number stayed above c_max = {self.numerics.c_max:g} "
                                   f"after {self.numerics.max_step_retries} halvings of the step", time=t0)
         self.fluid = trial
+        for name in FLUID_VOLUMES:
+            self.fluid_totals[name] += getattr(info, name)
         self.safety = 0.7 * self.safety if retry else min(1.0, 1.05 * self.safety)
         self._check_fluid(t0 + dt)
         self.time = t0 + dt

@@ -38,9 +38,14 @@ def test_slot_scene_matches_the_experiment():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="settled sand is dragged along the slot bottom (the bed has no shear resistance and "
-                          "creeps, see test_bed): a thin bank covers the whole length by ~13 s (measured 0.57); "
-                          "the area is +22 % at 10 s, +9 % at 15 s", strict=False)
+@pytest.mark.xfail(reason="bank AREA within 3 % at 15-25 s (+22 % at 10 s) but bank LENGTH 1.0 from ~8 s (exp. "
+                          "0.55-0.75): the slurry (rho_m - rho_f ~ 100 kg/m^3) sinks from the momentum-free inlet "
+                          "sources as a gravity current that runs along the slot bottom at ~0.4 m/s; sand reaching "
+                          "the bottom in it (theta_p 0.1-0.5 theta_cp) is carried at ~0.25 m/s to the far wall, "
+                          "where the bed starts (packed for x > 0.6 m at 5 s) and grows back towards the inlet. "
+                          "MP-PIC's isotropic stress (Eq. 16) gives no bed friction; adding the inlets' jet "
+                          "momentum (1 m/s, 0.5 in pipes) did not change it. See the bed-physics report.",
+                   strict=False)
 def test_chun_bank_length_and_area(shared_dir):
     data = np.loadtxt(shared_dir / "validation-data" / "chun_2020_bank_length_area_geos.txt")
 

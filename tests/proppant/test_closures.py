@@ -95,3 +95,16 @@ def test_slurry_viscosity_limits():
 def test_params_reject_bad_values_naming_the_field(field, value):
     with pytest.raises(SceneError, match=f"mppic.{field}"):
         MppicParams(**{field: value})
+
+
+def test_slurry_viscosity_cap():
+    """max_relative_viscosity caps mu_f / mu_0 of both laws; below the cap Eq. 10 is untouched."""
+    params = MppicParams(max_relative_viscosity=1000.0)
+    theta = np.array([0.3, 0.59, 0.6, 0.65])
+    mu = closures.slurry_viscosity(theta, 1e-3, params)
+    assert mu[0] == pytest.approx(1e-3 * 0.5 ** -1.82, rel=1e-14)
+    assert mu[1:] == pytest.approx(1.0, rel=1e-12)  # (1 - 0.59/0.6)^-1.82 = 1.7e3 > 1000
+    kd = MppicParams(viscosity_law="krieger-dougherty", max_relative_viscosity=50.0)
+    assert closures.slurry_viscosity(0.6, 1e-3, kd) == pytest.approx(0.05, rel=1e-12)
+    with pytest.raises(Exception, match="mppic.max_relative_viscosity"):
+        MppicParams(max_relative_viscosity=0.5)

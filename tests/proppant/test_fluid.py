@@ -186,9 +186,12 @@ def test_balance_with_leakoff_growth_and_outlet():
         assert info.leaked == pytest.approx(1e-5 * frame.dx * frame.dz * np.count_nonzero(grid.active) * dt,
                                             rel=1e-14)
         assert info.injected == pytest.approx(4e-6 * dt, rel=1e-14)
-        balance = info.injected - info.stored - info.leaked - info.outflow
+        balance = info.injected + info.opened - info.stored - info.leaked - info.outflow
         assert abs(balance) < 1e-12 * scale
         assert info.dropped == 0.0
+        # the cells that open are filled as a storage source (their fluid is not drawn through their faces)
+        opened = np.sum((1.0 - theta_p[:, 12:]) * 1e-3) * frame.dx * frame.dz  # theta_f w dA of the new cells
+        assert info.opened == (pytest.approx(opened, rel=1e-12) if n == 5 else 0.0)
 
 
 def test_reused_factorisation_gives_the_direct_solution():
