@@ -146,7 +146,9 @@ class FractureHistory:
 
         Linear in time between the snapshots bracketing t, f = (1 - a) f_k + a f_(k+1),
         a = (t - t_k) / (t_(k+1) - t_k); zero before the first snapshot, the last snapshot after it.
-        open_mask: width > 0.
+        open_mask: width > 0. A negative width is set to 0 (closed): the fracture engine has no contact
+        constraint, and cells pinched by a stress barrier can come out negative (down to -0.8 mm in the
+        five-layer demo) or drained by leak-off slightly below 0; leak-off is kept >= 0 and 0 in closed cells.
         """
         shape = (int(shape[0]), int(shape[1]))
         k = int(np.searchsorted(self.times, t, side="right")) - 1
@@ -159,7 +161,9 @@ class FractureHistory:
             a = (t - self.times[k]) / (self.times[k + 1] - self.times[k])
             (w0, q0), (w1, q1) = self._on(k, frame, shape), self._on(k + 1, frame, shape)
             width, leak = (1.0 - a) * w0 + a * w1, (1.0 - a) * q0 + a * q1
-        return width, leak, width > 0.0
+        width = np.maximum(width, 0.0)  # negative widths (no contact constraint in the engine) are closed
+        is_open = width > 0.0
+        return width, np.where(is_open, np.maximum(leak, 0.0), 0.0), is_open
 
     def width_field(self, frame: GridFrame, shape: Shape) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
         """``t -> (width, leakoff_rate)`` on the grid: the ``width_field`` the proppant simulator takes."""
@@ -228,12 +232,13 @@ def proppant_frame(history: FractureHistory, cell_size: float | tuple[float, flo
                                                                  int(last[0] - first[0] + 1))
 
 
-def bridging_risk(width: np.ndarray, diameter: float, factor: float) -> np.ndarray:
+def bridging_risk(width: np.ndarray, diameter: float | np.ndarray, factor: float) -> np.ndarray:
     """Open cells (width > 0) whose width is below factor x diameter: where packed proppant would bridge
     (the criterion of the parcels' push, hfgpu.proppant.params ``bridging_factor``; a screen-out diagnostic,
-    not fed back to the fracture)."""
+    not fed back to the fracture). ``diameter``: one grain size, or one per cell (same shape as width)."""
     for name, value in (("diameter", diameter), ("factor", factor)):
-        if not (np.isfinite(value) and value > 0.0):
-            raise ValueError(f"bridging_risk: {name} = {value}; must be a positive finite number")
+        value = np.asarray(value, dtype=np.float64)
+        if not np.all(np.isfinite(value) & (value > 0.0)):
+            raise ValueError(f"bridging_risk: {name} = {value}; must be positive finite number(s)")
     width = np.asarray(width, dtype=np.float64)
-    return (width > 0.0) & (width < factor * diameter)
+    return (width > 0.0) & (width < factor * np.asarray(diameter, dtype=np.float64))

@@ -1,7 +1,8 @@
 """Running a scene: pick the simulator the scene needs, fan its records out to the sinks, end the file.
 
 Only what the scene requires is imported: physics ["fracture"] loads ``hfgpu.fracture.simulator`` and
-no proppant code, ["proppant"] loads ``hfgpu.proppant.simulator`` and no fracture code.
+no proppant code, ["proppant"] loads ``hfgpu.proppant.simulator`` and no fracture code; both at once run the
+one-way coupled model of ``hfgpu.coupled`` (fracture first, proppant on its history).
 """
 
 from __future__ import annotations
@@ -13,8 +14,9 @@ from typing import Any, Callable
 from .errors import HfgpuError
 from .scene import Scene, load_scene
 
-#: The module whose ``simulate(scene, sink, progress=None) -> dict`` runs each single physics.
-SIMULATORS = {"fracture": "hfgpu.fracture.simulator", "proppant": "hfgpu.proppant.simulator"}
+#: The module whose ``simulate(scene, sink, progress=None) -> dict`` runs each physics set.
+SIMULATORS = {("fracture",): "hfgpu.fracture.simulator", ("proppant",): "hfgpu.proppant.simulator",
+              ("fracture", "proppant"): "hfgpu.coupled"}
 
 SINK_METHODS = ("fracture_snapshot", "fracture_balance", "proppant_snapshot", "proppant_balance")
 
@@ -42,16 +44,16 @@ class FanOut:
 
 
 def check_supported(scene: Scene) -> None:
-    """Raise :class:`NotSupportedError` for a physics set this version cannot run (several at once)."""
-    if len(scene.run.physics) != 1:
-        raise NotSupportedError(f"run.physics = {list(scene.run.physics)}: coupled runs land with the "
-                                "coupling issue; run \"fracture\" or \"proppant\" alone for now")
+    """Raise :class:`NotSupportedError` for a physics set this version cannot run."""
+    if tuple(scene.run.physics) not in SIMULATORS:
+        raise NotSupportedError(f"run.physics = {list(scene.run.physics)}: allowed sets are "
+                                f"{[list(k) for k in SIMULATORS]}")
 
 
 def simulator_for(scene: Scene) -> Callable[..., dict]:
-    """The ``simulate`` function for the scene's one physics, imported now (and nothing else)."""
+    """The ``simulate`` function for the scene's physics set, imported now (and nothing else)."""
     check_supported(scene)
-    return importlib.import_module(SIMULATORS[scene.run.physics[0]]).simulate
+    return importlib.import_module(SIMULATORS[tuple(scene.run.physics)]).simulate
 
 
 def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = True,

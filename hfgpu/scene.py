@@ -173,7 +173,7 @@ class Injection:
 @dataclass(frozen=True)
 class Mesh:
     """Cell sizes [m]; ``max_cells_across`` caps the footprint's cells along x or z (the fracture grid
-    is coarsened 2x2 beyond it), None for no cap."""
+    is coarsened 3x3 beyond it, see docs/scene.md), None for no cap."""
 
     dx: float
     dz: float
@@ -196,6 +196,7 @@ class Scene:
     injection: Injection | None = None
     fracture: Any = None  # hfgpu.fracture.config.FractureNumerics when "fracture" in physics
     proppant: Any = None  # hfgpu.proppant.config.ProppantSetup when "proppant" in physics
+    coupling: Any = None  # hfgpu.coupled.CouplingConfig when physics has both "fracture" and "proppant"
     source: str = field(default="", repr=False, compare=False)  # the TOML text, stored in results
 
     def has(self, physics: str) -> bool:
@@ -267,9 +268,17 @@ def parse_scene(data: dict, source: str = "") -> Scene:
     if injection_table is not None:
         densities = proppant.class_densities() if proppant is not None else {}
         injection = _parse_injection(injection_table, densities)
+    coupling = None
+    if len(run.physics) > 1:
+        from .coupled import parse_coupling
+
+        coupling = parse_coupling(top.table("coupling", {}), run.end_time)
+    elif top.has("coupling"):
+        top.raw("coupling")
+        raise SceneError("coupling", "(table)", 'this section needs both "fracture" and "proppant" in run.physics')
     top.finish()
     return Scene(run=run, fluid=fluid, mesh=mesh, output=output, rock=rock, injection=injection,
-                 fracture=fracture, proppant=proppant, source=source)
+                 fracture=fracture, proppant=proppant, coupling=coupling, source=source)
 
 
 def _parse_run(t: Table) -> RunConfig:

@@ -246,3 +246,16 @@ def test_equal_times_keep_the_last_snapshot_and_bad_input_is_named():
         proppant_frame(history, cell_size=-1.0)
     with pytest.raises(ValueError, match="margin = -1"):
         proppant_frame(history, margin=-1)
+
+
+def test_negative_widths_are_closed_with_no_leakoff():
+    """The fracture engine has no contact constraint: a pinched cell may come out with w < 0. The proppant
+    grid sees it closed (w = 0, leak-off 0), and negative leak-off rates are cut to 0."""
+    frame = GridFrame(dx=1.0, dz=1.0, x0=0.0, z0=0.0)
+    width = np.array([[1e-3, -8e-4], [2e-3, 5e-4]])
+    leak = np.array([[1e-6, 2e-6], [-1e-9, 3e-6]])
+    history = FractureHistory([_snapshot(1.0, frame, width, leak=leak, opened=np.zeros((2, 2)))])
+    w, q, is_open = history.fields_at(2.0, frame, (2, 2))
+    np.testing.assert_array_equal(w, [[1e-3, 0.0], [2e-3, 5e-4]])
+    np.testing.assert_array_equal(q, [[1e-6, 0.0], [0.0, 3e-6]])
+    np.testing.assert_array_equal(is_open, [[True, False], [True, True]])

@@ -3,7 +3,9 @@
 Depth z is drawn downward; maps use each snapshot's own grid frame (cell centres x0 + i dx, z0 + j dz).
 Fracture: width maps at a few times with the cross-section at x = x_injection, footprint outlines over
 time, area and efficiency vs time, volume balance. Proppant (last snapshot): volume fraction map, map of
-the mean parcel speed per cell, parcels coloured by radius, solid balance.
+the mean parcel speed per cell, parcels coloured by radius, solid balance. Coupled runs (both physics) add
+the paper's Figs. 13-18: volume fraction and speed maps over time, fluid streamlines, |u_p| probability
+plots at 1260 / 1800 / 3600 s (nearest snapshots), fracture and propped area vs time.
 """
 
 from __future__ import annotations
@@ -135,17 +137,91 @@ def volume_fraction_map(snap: ProppantSnapshot) -> Figure:
     return fig
 
 
-def parcel_speed_map(snap: ProppantSnapshot) -> Figure:
-    """Mean parcel speed [m/s] per grid cell (cells without parcels left blank)."""
+def _mean_speed(snap: ProppantSnapshot) -> np.ndarray:
+    """Mean parcel speed [m/s] per grid cell (NaN where the cell holds no parcel)."""
     nz, nx = snap.grid["volume_fraction"].shape
     f, p = snap.frame, snap.parcels
     edges = (f.z0 + f.dz * (np.arange(nz + 1) - 0.5), f.x0 + f.dx * (np.arange(nx + 1) - 0.5))
     speed = np.hypot(p["u"], p["v"])
     total, _, _ = np.histogram2d(p["z"], p["x"], bins=edges, weights=speed)
     count, _, _ = np.histogram2d(p["z"], p["x"], bins=edges)
-    mean = np.where(count > 0, total / np.maximum(count, 1), np.nan)
-    fig = _domain_figure(f, (nz, nx))
-    _map(fig, fig.subplots(), f, mean, "mean parcel speed [m/s]", f"parcel speed, t = {snap.time:.4g} s")
+    return np.where(count > 0, total / np.maximum(count, 1), np.nan)
+
+
+def parcel_speed_map(snap: ProppantSnapshot) -> Figure:
+    """Mean parcel speed [m/s] per grid cell (cells without parcels left blank)."""
+    mean = _mean_speed(snap)
+    fig = _domain_figure(snap.frame, mean.shape)
+    _map(fig, fig.subplots(), snap.frame, mean, "mean parcel speed [m/s]", f"parcel speed, t = {snap.time:.4g} s")
+    return fig
+
+
+def proppant_maps(results: Results, count: int = 4) -> Figure:
+    """Volume fraction (top row) and mean parcel speed (bottom row) at up to ``count`` times (the paper's
+    Fig. 14); cells flagged ``bridging_risk`` are outlined in red where the file has that field."""
+    snaps = [results.proppant_snapshots[i] for i in _picks(len(results.proppant_snapshots), count)]
+    fig = Figure(figsize=(4.5 * len(snaps), 6), layout="constrained")
+    axes = fig.subplots(2, len(snaps), squeeze=False)
+    for top, bottom, snap in zip(axes[0], axes[1], snaps):
+        _map(fig, top, snap.frame, snap.grid["volume_fraction"], "volume fraction [-]", f"t = {snap.time:.4g} s")
+        if "bridging_risk" in snap.grid and snap.grid["bridging_risk"].any() and min(snap.grid["width"].shape) > 1:
+            x, z = snap.frame.centres(*snap.grid["width"].shape)
+            top.contour(x, z, snap.grid["bridging_risk"].astype(float), levels=[0.5], colors=["r"], linewidths=0.8)
+        _map(fig, bottom, snap.frame, _mean_speed(snap), "mean parcel speed [m/s]", "")
+    return fig
+
+
+def streamlines(snap: ProppantSnapshot) -> Figure:
+    """Streamlines of the fluid velocity (face values averaged to the cell centres, zero in closed cells)
+    over the width map [mm], coloured by speed (the paper's Fig. 13c, 15j-l)."""
+    g, f = snap.grid, snap.frame
+    width = np.asarray(g["width"])
+    u = 0.5 * (g["fluid_u"][:, :-1] + g["fluid_u"][:, 1:])
+    v = 0.5 * (g["fluid_v"][:-1, :] + g["fluid_v"][1:, :])
+    u, v = np.where(width > 0, u, 0.0), np.where(width > 0, v, 0.0)
+    fig = _domain_figure(f, width.shape)
+    ax = fig.subplots()
+    _map(fig, ax, f, np.where(width > 0, width * 1e3, np.nan), "width [mm]", f"fluid streamlines, t = {snap.time:.4g} s")
+    x, z = f.centres(*width.shape)
+    if min(width.shape) >= 2 and np.any(u) | np.any(v):
+        lines = ax.streamplot(x, z, u, v, color=np.hypot(u, v), cmap="magma", density=1.2, linewidth=0.7)
+        fig.colorbar(lines.lines, ax=ax, label="fluid speed [m/s]")
+    ax.set(xlim=(x[0] - f.dx / 2, x[-1] + f.dx / 2), ylim=(z[-1] + f.dz / 2, z[0] - f.dz / 2))
+    return fig
+
+
+def speed_probability(results: Results, times: tuple[float, ...] | None = None) -> Figure:
+    """Cumulative probability of the parcel speed |u_p| at the snapshots nearest ``times`` (the paper's
+    Fig. 16; default 1260 / 1800 / 3600 s, or the same fractions of a shorter slurry period,
+    :func:`hfgpu.propped.results_times`), with the packed-parcel threshold of :mod:`hfgpu.propped` dotted."""
+    from ..propped import PACKED_SPEED, packed_fraction, results_times
+
+    times = results_times(results) if times is None else times
+    fig = Figure(figsize=(4.5 * len(times), 4), layout="constrained")
+    for ax, t in zip(fig.subplots(1, len(times), squeeze=False)[0], times):
+        snap = results.proppant_snapshots.at(t)
+        speed = np.sort(np.hypot(snap.parcels["u"], snap.parcels["v"]))
+        if speed.size:
+            ax.plot(speed, (np.arange(speed.size) + 0.5) / speed.size, ".", ms=2)
+        ax.axvline(PACKED_SPEED, color="k", ls=":", lw=0.8)
+        ax.set(xlabel="|u_p| [m/s]", ylabel="cumulative probability [-]", ylim=(0, 1),
+               title=f"t = {snap.time:.4g} s, packed {packed_fraction(snap.parcels):.2f}")
+    return fig
+
+
+def propped_area(results: Results) -> Figure:
+    """Fracture area (fracture snapshots), created and propped area (proppant grid) vs time (Fig. 18)."""
+    from ..propped import area_history, fracture_area_history
+
+    fig = Figure(figsize=(7, 4.5), layout="constrained")
+    ax = fig.subplots()
+    frac = fracture_area_history(results)
+    ax.plot(frac["time"], frac["area"], label="fracture area")
+    areas = area_history(results)
+    ax.plot(areas["time"], areas["created"], "--", label="open area (proppant grid)")
+    ax.plot(areas["time"], areas["propped"], "o-", ms=3, label="propped area")
+    ax.set(xlabel="time [s]", ylabel="area [m^2]", title="created and propped area")
+    ax.legend()
     return fig
 
 
@@ -194,6 +270,9 @@ def figures(results: Results) -> dict[str, Figure]:
                    proppant_radius=parcels_by_radius(last))
     if results.proppant_balance:
         out["proppant_volume_balance"] = proppant_balance(results)
+    if len(results.fracture_snapshots) and len(results.proppant_snapshots):  # a coupled run
+        out.update(proppant_maps=proppant_maps(results), proppant_streamlines=streamlines(results.proppant_snapshots[-1]),
+                   proppant_speed_probability=speed_probability(results), propped_area=propped_area(results))
     return out
 
 

@@ -44,6 +44,7 @@ UNITS = {
     "net_pressure": "Pa", "min_stress": "Pa", "toughness": "Pa m^0.5", "leakoff_coefficient": "m/s^0.5",
     "x": "m", "z": "m", "u": "m/s", "v": "m/s", "radius": "m", "density": "kg/m^3", "particles": "1",
     "state": "1", "class_id": "1", "volume_fraction": "1", "fluid_u": "m/s", "fluid_v": "m/s",
+    "bridging_risk": "1",
     "scene": "",
 }
 UNKNOWN_UNITS = "unspecified"

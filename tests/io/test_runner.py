@@ -52,10 +52,14 @@ def test_simulation_error_is_recorded_and_reraised(tmp_path, monkeypatch):
     assert r.summary["error_type"] == "SimulationError" and r.summary["fracture_steps"] == 24
 
 
-def test_coupled_physics_refused_before_any_work(tmp_path):
+def test_coupled_physics_dispatch_to_the_coupled_model_and_unknown_sets_are_refused(tmp_path):
+    import hfgpu.coupled
+    from hfgpu.runner import simulator_for
+
     scene = fakes.proppant_scene().replace(run=RunConfig(end_time=1.0, physics=("fracture", "proppant")))
-    with pytest.raises(NotSupportedError, match="coupled runs land with the coupling issue"):
-        run(scene, tmp_path / "r.h5")
+    assert simulator_for(scene) is hfgpu.coupled.simulate
+    with pytest.raises(NotSupportedError, match="allowed sets"):
+        run(scene.replace(run=RunConfig(end_time=1.0, physics=("proppant", "fracture"))), tmp_path / "r.h5")
     assert not (tmp_path / "r.h5").exists()
 
 

@@ -1,0 +1,244 @@
+"""The integrated, one-way coupled run (the paper, section 4.3 and Fig. 4): fracture first, proppant on it.
+
+A scene with ``physics = ["fracture", "proppant"]`` runs
+
+1. the planar-3D fracture engine over the whole schedule, its snapshots every ``[coupling] fracture_every``
+   going both to the output sink (the results file) and to memory;
+2. the MP-PIC proppant model on one fixed grid (:func:`hfgpu.coupling.proppant_frame`, cells of
+   ``[coupling] cell_size``) whose width and leak-off follow the fracture history, linear in time
+   (:class:`hfgpu.coupling.FractureHistory`); the fracture is not solved again (one-way coupling). The slurry
+   enters through an annulus of cells around the perforation (the paper's annular injection zone) at the
+   schedule's rate Q(t) and volume fraction. The proppant run starts at ``[coupling] proppant_start``
+   (default: the start of the first stage that carries proppant, i.e. the end of the pad): before it the
+   fracture holds clean fluid only, which the one-way coupling does not need to simulate.
+
+Screen-out risk (reported, not fed back): each proppant snapshot gets a grid field ``bridging_risk`` (1 where a
+cell holds proppant and its width is below ``bridging_factor`` x the largest parcel diameter in it, the
+criterion of :func:`hfgpu.coupling.bridging_risk`); the summary has ``screen_out_cells`` (at the end),
+``screen_out_cells_max`` and ``screen_out_first_time`` (NaN when never).
+
+``[coupling]`` keys (all optional): ``fracture_every`` (default end_time / 60), ``cell_size`` (one length or
+[dx, dz]; default the fracture cells), ``inlet_inner_radius`` (default 0), ``inlet_radius`` (outer radius of the
+annulus, default 1.5 x the larger proppant cell size: the injection cell and its eight neighbours),
+``proppant_start`` (see above), ``margin`` (cells around the largest footprint, default 1).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time as _time
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+from .coupling import FractureHistory, bridging_risk, proppant_frame
+from .errors import SceneError
+from .fracture.simulator import simulate as simulate_fracture
+from .proppant.config import Geometry, Port
+from .proppant.simulator import ProppantSimulation
+from .records import GridFrame, ProppantSnapshot, SolidBalanceRecord
+from .scene import Scene, Schedule
+from .scene_reader import Table
+
+#: Snapshots of the fracture per run when ``fracture_every`` is not given.
+DEFAULT_FRACTURE_SNAPSHOTS = 60
+#: Default outer radius of the inlet annulus, in (larger) proppant cell sizes.
+DEFAULT_INLET_CELLS = 1.5
+
+
+@dataclass(frozen=True)
+class CouplingConfig:
+    """``[coupling]``: how the proppant run reads the fracture (see the module docstring)."""
+
+    fracture_every: float
+    cell_size: tuple[float, float] | None = None
+    inlet_inner_radius: float = 0.0
+    inlet_radius: float | None = None
+    proppant_start: float | None = None
+    margin: int = 1
+
+
+def parse_coupling(t: Table, end_time: float) -> CouplingConfig:
+    """Read ``[coupling]`` (every key optional) into a :class:`CouplingConfig`."""
+    positive = dict(minimum=0.0, exclusive_minimum=True)
+    every = t.quantity("fracture_every", "time", end_time / DEFAULT_FRACTURE_SNAPSHOTS, **positive)
+    size = t.raw("cell_size", None)
+    cell_size = None
+    if size is not None:
+        items = size if isinstance(size, list) else [size, size]
+        if len(items) != 2:
+            raise SceneError(t.key_path("cell_size"), size, 'expected one length or two, ["dx", "dz"]')
+        cell_size = tuple(Table({"cell_size": s}, t.path).quantity("cell_size", "length", **positive)
+                          for s in items)
+    inner = t.quantity("inlet_inner_radius", "length", 0.0, minimum=0.0)
+    outer = t.quantity("inlet_radius", "length", None, minimum=inner, exclusive_minimum=True)
+    start = t.quantity("proppant_start", "time", None, minimum=0.0, maximum=end_time, exclusive_maximum=True)
+    margin = t.integer("margin", 1, minimum=0)
+    t.finish()
+    return CouplingConfig(fracture_every=every, cell_size=cell_size, inlet_inner_radius=inner,
+                          inlet_radius=outer, proppant_start=start, margin=margin)
+
+
+def proppant_start_time(scene: Scene) -> float:
+    """When the proppant run starts: ``[coupling] proppant_start``, else the start of the first stage that
+    carries proppant (the end of the pad); a scene whose schedule has no proppant stage is refused."""
+    if scene.coupling.proppant_start is not None:
+        return scene.coupling.proppant_start
+    start = 0.0
+    for stage in scene.injection.schedule.stages:
+        if stage.proppant is not None:
+            return start
+        start = stage.until
+    raise SceneError("injection.schedule", "(no proppant stage)",
+                     'a coupled run needs a stage with proppant = "<class>" (or set [coupling] proppant_start)')
+
+
+def shifted_schedule(schedule: Schedule, start: float) -> Schedule:
+    """The schedule seen from ``start`` on (times minus start; a stage cut at start keeps the loading it has
+    there, ramping on to its end value)."""
+    stages, begin = [], 0.0
+    for stage in schedule.stages:
+        if stage.until > start:
+            fraction = stage.volume_fraction
+            if begin < start:
+                s = (start - begin) / (stage.until - begin)
+                fraction += s * (stage.end_volume_fraction - stage.volume_fraction)
+            stages.append(dataclasses.replace(stage, until=stage.until - start, volume_fraction=fraction))
+        begin = stage.until
+    return Schedule(tuple(stages))
+
+
+def proppant_scene(scene: Scene, frame: GridFrame, shape: tuple[int, int], width: np.ndarray,
+                   start: float) -> Scene:
+    """The proppant-only scene of the coupled run: a "field" geometry on (frame, shape) with the width at
+    ``start``, the annular inlet around the perforation, clocks shifted so that its t = 0 is ``start``."""
+    nz, nx = shape
+    x, z = frame.centres(nz, nx)
+    inj, cfg = scene.injection, scene.coupling
+    outer = cfg.inlet_radius if cfg.inlet_radius is not None else DEFAULT_INLET_CELLS * max(frame.dx, frame.dz)
+    inlet = Port("annulus", x=inj.x, depth=inj.depth, inner_radius=cfg.inlet_inner_radius, outer_radius=outer)
+    geometry = Geometry(kind="field", length=nx * frame.dx, height=nz * frame.dz, field_x=x, field_z=z,
+                        field_w=np.asarray(width, dtype=np.float64), inlets=(inlet,))
+    return scene.replace(
+        run=dataclasses.replace(scene.run, end_time=scene.run.end_time - start, physics=("proppant",)),
+        injection=dataclasses.replace(inj, schedule=shifted_schedule(inj.schedule, start)),
+        proppant=dataclasses.replace(scene.proppant, geometry=geometry),
+        mesh=dataclasses.replace(scene.mesh, dx=frame.dx, dz=frame.dz))
+
+
+def cell_indices(frame: GridFrame, shape: tuple[int, int], x: np.ndarray, z: np.ndarray) -> tuple:
+    """(k, i) of the cells holding points (x, z), clipped to the grid."""
+    nz, nx = shape
+    i = np.clip(np.floor((np.asarray(x) - frame.x0) / frame.dx + 0.5).astype(int), 0, nx - 1)
+    k = np.clip(np.floor((np.asarray(z) - frame.z0) / frame.dz + 0.5).astype(int), 0, nz - 1)
+    return k, i
+
+
+def screen_out_cells(snap: ProppantSnapshot, factor: float) -> np.ndarray:
+    """Cells holding parcels whose width is below ``factor`` x the largest parcel diameter in the cell
+    (:func:`hfgpu.coupling.bridging_risk` with each cell's own largest grain)."""
+    width = np.asarray(snap.grid["width"], dtype=np.float64)
+    diameter = np.zeros(width.shape)
+    p = snap.parcels
+    if len(p["x"]):
+        k, i = cell_indices(snap.frame, width.shape, p["x"], p["z"])
+        np.maximum.at(diameter, (k, i), 2.0 * np.asarray(p["radius"]))
+    held = diameter > 0.0
+    out = np.zeros(width.shape, dtype=bool)
+    if held.any():
+        out[held] = bridging_risk(width[held], diameter[held], factor)
+    return out
+
+
+class Timings:
+    """Wall time [s] per phase (time.perf_counter): fracture, fluid (SIMPLE steps), parcels (particle
+    sub-loops), io (sinks); the rest of a run (scatter, injection, width resampling, set-up) is not split."""
+
+    def __init__(self):
+        self.seconds = {"fracture": 0.0, "fluid": 0.0, "parcels": 0.0, "io": 0.0}
+
+    def wrap(self, key: str, function: Callable) -> Callable:
+        """``function`` with its wall time added to ``seconds[key]``."""
+        def timed(*args, **kwargs):
+            t0 = _time.perf_counter()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                self.seconds[key] += _time.perf_counter() - t0
+        return timed
+
+
+class _FractureTee:
+    """Sink of the fracture phase: records go on to ``sink``; snapshots are also kept in ``snapshots``."""
+
+    def __init__(self, sink: Any, timings: Timings):
+        self.snapshots: list = []
+        self._snap = timings.wrap("io", sink.fracture_snapshot)
+        self.fracture_balance = timings.wrap("io", sink.fracture_balance)
+
+    def fracture_snapshot(self, snap) -> None:
+        self.snapshots.append(snap)
+        self._snap(snap)
+
+
+class _ProppantShift:
+    """Sink of the proppant phase: times moved back by ``start``, ``bridging_risk`` added to the grid."""
+
+    def __init__(self, sink: Any, start: float, factor: float, timings: Timings):
+        self.start, self.factor = start, factor
+        self._snap = timings.wrap("io", sink.proppant_snapshot)
+        self._balance = timings.wrap("io", sink.proppant_balance)
+        self.flagged = 0
+        self.flagged_max = 0
+        self.first_time = math.nan
+
+    def proppant_snapshot(self, snap: ProppantSnapshot) -> None:
+        risk = screen_out_cells(snap, self.factor)
+        t = snap.time + self.start
+        self.flagged = int(risk.sum())
+        self.flagged_max = max(self.flagged_max, self.flagged)
+        if self.flagged and math.isnan(self.first_time):
+            self.first_time = t
+        self._snap(dataclasses.replace(snap, time=t, grid={**snap.grid, "bridging_risk": risk.astype(np.int8)}))
+
+    def proppant_balance(self, record: SolidBalanceRecord) -> None:
+        self._balance(dataclasses.replace(record, time=record.time + self.start))
+
+
+def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None = None,
+             timings: Timings | None = None) -> dict:
+    """Run the coupled scene (module docstring): fracture, then proppant on the fracture history.
+
+    ``sink`` gets the fracture and the proppant records (proppant times on the scene's clock); ``progress(t)``
+    is called through both phases; ``timings`` (optional) collects wall time per phase. Returns a summary:
+    the fracture's values prefixed ``fracture_``, the proppant's prefixed ``proppant_``, the proppant grid
+    (``proppant_nx``, ``proppant_nz``, ``proppant_dx``, ``proppant_dz``), ``proppant_start``, the screen-out
+    counts and ``time_<phase>`` wall times.
+    """
+    timings = timings if timings is not None else Timings()
+    start = proppant_start_time(scene)
+    cfg = scene.coupling
+    tee = _FractureTee(sink, timings)
+    fracture_scene = scene.replace(output=dataclasses.replace(scene.output, every=cfg.fracture_every))
+    t0 = _time.perf_counter()
+    fracture = simulate_fracture(fracture_scene, tee, progress)
+    history = FractureHistory(tee.snapshots)
+    timings.seconds["fracture"] += _time.perf_counter() - t0 - timings.seconds["io"]
+    inj = scene.injection
+    frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=(inj.x, inj.depth))
+    width0, _, _ = history.fields_at(start, frame, shape)
+    sub = proppant_scene(scene, frame, shape, width0, start)
+    sim = ProppantSimulation(sub, width_field=lambda t: history.fields_at(t + start, frame, shape)[:2])
+    sim.solver.step = timings.wrap("fluid", sim.solver.step)
+    sim._particle_subloop = timings.wrap("parcels", sim._particle_subloop)
+    shift = _ProppantShift(sink, start, scene.proppant.params.bridging_factor, timings)
+    proppant = sim.run(shift, None if progress is None else (lambda t: progress(t + start)))
+    summary = {f"fracture_{k}": v for k, v in fracture.items()}
+    summary.update({f"proppant_{k}": v for k, v in proppant.items()}, proppant_time=proppant["time"] + start)
+    summary.update(proppant_start=start, proppant_nx=shape[1], proppant_nz=shape[0], proppant_dx=frame.dx,
+                   proppant_dz=frame.dz, screen_out_cells=shift.flagged, screen_out_cells_max=shift.flagged_max,
+                   screen_out_first_time=shift.first_time, time=scene.run.end_time)
+    summary.update({f"time_{k}": v for k, v in timings.seconds.items()})
+    return summary
