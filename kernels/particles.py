@@ -284,16 +284,38 @@ def lanes(arr: ti.template(), p0: ti.i32, n: ti.i32):
 
 
 @ti.func
+def on_bed(sx: ti.f64, sz: ti.f64, radius: ti.f64, dz: ti.f64, theta: ti.template(), width: ti.template(),
+           dense: ti.f64) -> ti.f64:
+    """1.0 where the cell containing (sx, sz) or the cell below it (+z) has theta_p >= dense, or the cell below
+    is closed or outside the grid and the parcel is within 2 radius of that wall, else 0.0
+    (particle_ops_numpy._on_bed; 0 outside the grid)."""
+    out = 0.0
+    i = ti.cast(ti.floor(sx + 0.5), ti.i32)
+    k = ti.cast(ti.floor(sz + 0.5), ti.i32)
+    if k >= 0 and k < theta.shape[0] and i >= 0 and i < theta.shape[1]:
+        if theta[k, i] >= dense:
+            out = 1.0
+        if closed(k + 1, i, width):
+            if (k + 0.5 - sz) * dz <= 2.0 * radius:
+                out = 1.0
+        elif theta[k + 1, i] >= dense:
+            out = 1.0
+    return out
+
+
+@ti.func
 def velocity_lanes(p0: ti.i32, n: ti.i32, u: ti.template(), v: ti.template(), radius: ti.template(),
                    density: ti.template(), s_u: ti.template(), s_v: ti.template(), s_dpdx: ti.template(),
                    s_dpdz: ti.template(), s_dtaudx: ti.template(), s_dtaudz: ti.template(),
                    s_theta: ti.template(), s_mean_u: ti.template(), s_mean_v: ti.template(),
                    s_damping: ti.template(), s_width: ti.template(), dt: ti.f64, rho_f: ti.f64, mu: ti.f64,
                    gravity: ti.f64, theta_cp: ti.f64, epsilon: ti.f64, restitution: ti.f64, law: ti.i32,
-                   re_coefficient: ti.f64, bridging_factor: ti.f64, iterations: ti.i32):
-    """New velocities (Eq. 43 with the packing limiter and bridging of particle_ops_numpy.push), D_p of the
-    last drag solve and the bridged flags of the LANES parcels p0, p0 + 1, ... (vectors; lanes past n repeat
-    the last parcel).
+                   re_coefficient: ti.f64, bridging_factor: ti.f64, iterations: ti.i32, x: ti.template(),
+                   z: ti.template(), x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, theta_grid: ti.template(),
+                   width: ti.template(), bed_friction: ti.f64, friction_fraction: ti.f64):
+    """New velocities (Eq. 43 with the packing limiter, bed friction and bridging of particle_ops_numpy.push),
+    D_p of the last drag solve and the bridged flags of the LANES parcels p0, p0 + 1, ... (vectors; lanes past
+    n repeat the last parcel).
 
     D_p = 4.5 mu / (rho_p r^2) x C_d Re / 24 (Eq. 13-15, closures.drag_rate): law 0 Eq. 14 (theta_f^-2.65
     (1 + c Re^0.687) below Re = 1000, else 0.44 Re / 24 theta_f^-2.65), law 1 Snider (2001)."""
@@ -337,6 +359,10 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, u: ti.template(), v: ti.template(), ra
     gz = lanes(s_dtaudz, p0, n)
     un = un + limited(scale * gx, mean_u - un, gx, restitution)
     vn = vn + limited(scale * gz, mean_v - vn, gz, restitution)
+    bed = ti.Vector([on_bed((x[ti.min(p0 + l, n - 1)] - x0) / dx, (z[ti.min(p0 + l, n - 1)] - z0) / dz, r[l], dz,
+                            theta_grid, width, friction_fraction) for l in ti.static(range(LANES))], dt=ti.f64)
+    slide = ti.max(ti.abs(un) - dt * bed_friction * ti.abs(buoyant_g) / den, 0.0)
+    un = ti.select(bed > 0.0, ti.select(un < 0.0, -slide, slide), un)
     bridged = lanes(s_width, p0, n) < bridging_factor * 2.0 * r
     return ti.select(bridged, 0.0, un), ti.select(bridged, 0.0, vn), drag, bridged
 
@@ -370,7 +396,8 @@ def push(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, state: I1,
          x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, width: F2, cell_mask: F2, theta_grid: F2,
          dt: ti.f64, rho_f: ti.f64, mu: ti.f64, gravity: ti.f64,
          theta_cp: ti.f64, epsilon: ti.f64, restitution: ti.f64, law: ti.i32, re_coefficient: ti.f64,
-         bridging_factor: ti.f64, iterations: ti.i32, drag_out: F1):
+         bridging_factor: ti.f64, iterations: ti.i32, bed_friction: ti.f64, friction_fraction: ti.f64,
+         drag_out: F1):
     """Eq. 43-44 in place with what the parcels see (s_*, the rows of ParcelFluid); D_p into drag_out.
     One task per LANES parcels: velocity_lanes, then move for each."""
     n = ti.cast(x.shape[0], ti.i32)
@@ -379,7 +406,8 @@ def push(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, state: I1,
         un, vn, drag, bridged = velocity_lanes(p0, n, u, v, radius, density, s_u, s_v, s_dpdx, s_dpdz, s_dtaudx,
                                                s_dtaudz, s_theta, s_mean_u, s_mean_v, s_damping, s_width, dt,
                                                rho_f, mu, gravity, theta_cp, epsilon, restitution, law,
-                                               re_coefficient, bridging_factor, iterations)
+                                               re_coefficient, bridging_factor, iterations, x, z, x0, z0, dx,
+                                               dz, theta_grid, width, bed_friction, friction_fraction)
         for l in ti.static(range(LANES)):
             if p0 + l < n:
                 u[p0 + l] = un[l]

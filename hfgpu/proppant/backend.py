@@ -178,7 +178,8 @@ class TaichiBackend:
     def _push_constants(params: MppicParams) -> tuple:
         """The closure constants the push kernel takes, in its order."""
         return (params.theta_cp, params.epsilon, params.packing_restitution, params.drag_law_code,
-                params.drag_re_coefficient, params.bridging_factor, params.drag_iterations)
+                params.drag_re_coefficient, params.bridging_factor, params.drag_iterations,
+                params.bed_friction, params.friction_volume_fraction)
 
     def exchange(self, parcels: Parcels, seen: ParcelFluid, drag: np.ndarray, frame: GridFrame,
                  width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

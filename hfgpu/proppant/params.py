@@ -35,6 +35,16 @@ class MppicParams:
     driven into a denser region faster than the mean parcel velocity is sent back at most e times its
     relative velocity. Default 0 (inelastic): a bed whose stress carries its weight is then exactly at rest.
     damping: collision damping on/off; active only where theta_p > damping_threshold x theta_cp.
+    bed_friction: Coulomb friction coefficient mu_b of a parcel resting in or on a dense bed (push,
+    particle_ops_numpy._bed_friction): its velocity along the bed (x, normal to gravity) loses at most
+    dt mu_b |1 - rho_f/rho_p| g per step (the friction its own submerged weight can mobilise), so a resting grain
+    stays put until the tangential drag exceeds mu_b x its submerged weight (static friction), and a sliding
+    one is slowed. Default tan(28.5 deg) = 0.543, the angle of internal friction of Johnson & Jackson (1987,
+    J. Fluid Mech. 176) used for sand-like beds in MFIX; 0 turns it off.
+    friction_volume_fraction: a parcel feels bed friction where theta_p of its own cell or of the cell below it
+    (+z) is >= this (a contact network), and also where it lies on a floor (within one diameter of a closed
+    cell or the grid edge below it); default 0.5, the onset of frictional stress of Johnson & Jackson (1987)
+    (MFIX EPS_F_MIN = 0.5). Suspended parcels in a dilute suspension never feel it.
     """
 
     theta_cp: float = 0.6
@@ -52,6 +62,8 @@ class MppicParams:
     packing_restitution: float = 0.0
     damping: bool = True
     damping_threshold: float = 0.5
+    bed_friction: float = 0.543
+    friction_volume_fraction: float = 0.5
 
     def __post_init__(self) -> None:
         def bad(name: str, allowed: str) -> SceneError:
@@ -62,7 +74,7 @@ class MppicParams:
         for name in ("P_s", "epsilon"):
             if not getattr(self, name) > 0.0:
                 raise bad(name, "allowed: a number > 0")
-        for name in ("beta", "drag_re_coefficient", "bridging_factor"):
+        for name in ("beta", "drag_re_coefficient", "bridging_factor", "bed_friction"):
             if not getattr(self, name) >= 0.0:
                 raise bad(name, "allowed: a number >= 0")
         for name in ("restitution", "packing_restitution"):
@@ -83,6 +95,8 @@ class MppicParams:
             raise bad("damping", "allowed: true or false")
         if not 0.0 <= self.damping_threshold <= 1.0:
             raise bad("damping_threshold", "allowed: 0 <= damping_threshold <= 1")
+        if not 0.0 < self.friction_volume_fraction < 1.0:
+            raise bad("friction_volume_fraction", "allowed: 0 < friction_volume_fraction < 1")
 
     @property
     def drag_law_code(self) -> int:

@@ -180,6 +180,30 @@ def _limited_stress_velocity(delta, slip, grad, restitution):
                     np.minimum(np.maximum(delta, bound), 0.0))
 
 
+def _on_bed(x, z, radius, frame: GridFrame, fields: GridFields, params: MppicParams) -> np.ndarray:
+    """True where the parcel rests in or on a dense bed: its own cell or the cell below it (+z, the direction
+    of gravity) has theta_p (Eq. 38, this step's scatter) >= friction_volume_fraction; or it lies on the floor:
+    the cell below is closed or outside the grid and the parcel is within one diameter 2 r of that wall (the
+    sub-cell layer of grains on a floor that a cell-averaged theta_p does not resolve)."""
+    nz, _ = fields.width.shape
+    k, i, inside = owning_cell(x, z, frame, fields.width.shape)
+    below = np.minimum(k + 1, nz - 1)
+    has_below = k + 1 < nz
+    dense = (fields.volume_fraction[k, i] >= params.friction_volume_fraction) \
+        | (has_below & (fields.volume_fraction[below, i] >= params.friction_volume_fraction))
+    floor = ~has_below | (fields.width[below, i] <= 0.0)
+    on_floor = floor & ((k + 0.5 - (z - frame.z0) / frame.dz) * frame.dz <= 2.0 * radius)
+    return inside & (dense | on_floor)
+
+
+def _bed_friction(u, on_bed, buoyant_g, dt, den, params: MppicParams):
+    """Coulomb friction along a bed (velocity component normal to gravity) in the implicit update of Eq. 43:
+    the friction force per unit mass mu_b |g'| (g' = (1 - rho_f/rho_p) g, the submerged weight) opposes the
+    motion and, being static friction, at most cancels it: u <- sign(u) max(|u| - dt mu_b |g'| / den, 0)."""
+    slide = np.maximum(np.abs(u) - dt * params.bed_friction * np.abs(buoyant_g) / den, 0.0)
+    return np.where(on_bed, np.copysign(slide, u), u)
+
+
 def _blocked(x, z, x_try, z_try, frame: GridFrame, fields: GridFields, params: MppicParams) -> np.ndarray:
     """True where the move (x, z) -> (x_try, z_try) leaves the grid, enters a closed cell, raises the
     bilinear weight (Eq. 37) of the parcel on a cell whose theta_p (Eq. 38, this step's scatter) is already
@@ -229,6 +253,8 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     bounds the velocity relative to the cell's mean parcel velocity, which does not stop a stream of parcels
     that arrives together against a wall; the cap bounds every cell's theta_p by theta_cp plus one step's
     inflow, whatever the parcels' velocities.
+    Bed friction: where the parcel rests in or on a dense bed or on the floor (_on_bed) its x velocity is
+    reduced by Coulomb friction (_bed_friction, mu_b = bed_friction) before the walls.
     Bridging: where the width of the parcel's cell is below bridging_factor x 2 r the parcel is set to state 1
     with zero velocity and does not move; others get state 0. Gravity [m/s^2] acts along +z (depth).
     """
@@ -249,6 +275,8 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
                                              params.packing_restitution)
     v_new = v_new + _limited_stress_velocity(scale * seen.dtaudz, seen.mean_v - v_new, seen.dtaudz,
                                              params.packing_restitution)
+    on_bed = _on_bed(parcels.x, parcels.z, parcels.radius, frame, fields, params)
+    u_new = _bed_friction(u_new, on_bed, buoyant_g, dt, den, params)
     bridged = seen.width < params.bridging_factor * 2.0 * parcels.radius
     u_new = np.where(bridged, 0.0, u_new)
     v_new = np.where(bridged, 0.0, v_new)

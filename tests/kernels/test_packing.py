@@ -1,5 +1,6 @@
 """Packing limiter of the push: a suspension settling onto the floor of a slot builds a bed that does not
-over-pack and then stays at rest (REFERENCE.md 6.5; Snider 2001 eqs. 39-41 plus the push's packing cap)."""
+over-pack and then stays at rest (REFERENCE.md 6.5; Snider 2001 eqs. 39-41 plus the push's packing cap); Coulomb
+bed friction holds grains resting on a bed or floor against a weak tangential flow and slows sliding ones."""
 
 import numpy as np
 import pytest
@@ -49,3 +50,49 @@ def test_settled_bed_does_not_overpack_and_stays_at_rest(backend_name):
     assert abs(depth[-1] - depth[-500]) < 1e-3 * frame.dz
     assert speed[-1] < 0.01 * 0.067
     assert np.mean(np.hypot(parcels.u, parcels.v) < 1e-6) > 0.95
+
+
+@pytest.mark.parametrize("backend_name", ["numpy", "taichi"])
+def test_bed_friction_holds_resting_grains_and_slows_sliding_ones(backend_name):
+    """Coulomb bed friction in the push (particle_ops_numpy._bed_friction): parcels at rest in a dense bottom
+    row (theta_p = 0.55 >= friction_volume_fraction 0.5, uniform: parcels at cell centres) and light ones in
+    the row above it (the cell below is dense) under a uniform fluid velocity U along the bed. From rest with
+    one drag solve and no damping, Eq. 43 gives u = dt D U / (1 + dt D); friction removes
+    dt mu_b (1 - rho_f/rho_p) g / (1 + dt D) of it, or all of it (static friction: held where D U < mu_b g').
+    In a loose bottom row (theta_p = 0.3) it does nothing to parcels at the cell centres, but acts on the same
+    parcels lying on the floor (within one diameter of it)."""
+    backend = get_backend(backend_name)
+    d, w, r, rho_p = 5e-3, 2e-3, 0.225e-3, 2550.0
+    frame = GridFrame(d, d, d / 2, d / 2)
+    width = np.full((2, 3), w)
+    g_sub = (1.0 - RHO_F / rho_p) * G
+    for theta, dense, bottom in ((0.55, True, 1.5 * d), (0.3, False, 1.5 * d), (0.3, True, 2 * d - 1.5 * r)):
+        n = 60
+        x = np.concatenate([np.tile([0.5 * d, 1.5 * d, 2.5 * d], n // 3), [0.5 * d, 1.5 * d, 2.5 * d]])
+        z = np.concatenate([np.full(n, bottom), np.full(3, 0.5 * d)])  # bottom row, row above
+        per = theta * 3 * d * d * w / (4 / 3 * np.pi * r ** 3) / n
+        particles = np.concatenate([np.full(n, per), np.full(3, 1e-3)])
+        for velocity in (0.002, 0.1):
+            u = np.full((2, 4), velocity)
+            v, p = np.zeros((3, 3)), np.zeros((2, 3))
+            result = {}
+            for mu_b in (0.0, 0.543):
+                params = MppicParams(damping=False, drag_iterations=1, bed_friction=mu_b)
+                parcels = Parcels.create(x, z, radius=r, density=rho_p, particles=particles)
+                moments = backend.scatter(parcels, frame, width)
+                fields = grid_fields(frame, width, u, v, p, moments, params)
+                seen = backend.gather(parcels, frame, fields)
+                drag = backend.push(parcels, seen, frame, fields, DT, params, RHO_F, MU, G)
+                result[mu_b] = parcels.u.copy(), drag
+            free, drag = result[0.0]
+            held, _ = result[0.543]
+            np.testing.assert_allclose(free, DT * drag * velocity / (1 + DT * drag), rtol=1e-12)
+            rests = np.full(n + 3, dense)
+            rests[n:] = theta > 0.5  # the light parcels above rest on the bottom row only if it is dense
+            np.testing.assert_array_equal(held[~rests], free[~rests])
+            if velocity == 0.002:
+                assert np.all(drag * velocity < 0.543 * g_sub) and np.all(held[rests] == 0.0)
+            else:
+                expected = free - DT * 0.543 * g_sub / (1 + DT * drag)
+                assert np.all(expected > 0.0)
+                np.testing.assert_allclose(held[rests], expected[rests], rtol=1e-12)

@@ -1,6 +1,6 @@
 """A settled bed: the packing limiter keeps theta_p <= 1.05 theta_cp, its height matches the solid volume at
 close packing, its fluid is held by the slurry viscosity's wall friction, and its parcels come to rest (parcel
-speeds < 1e-6 m/s: not yet, see the xfail)."""
+speeds < 1e-6 m/s; the surface grains thanks to bed friction)."""
 
 from __future__ import annotations
 
@@ -72,12 +72,10 @@ def test_settled_bed_is_packed_and_its_fluid_at_rest(settled):
     assert speed[deep].max() < 1e-6  # ... and all of it below the surface rows (wall half cells included)
 
 
-@pytest.mark.xfail(reason="grains on the bed surface (theta_p ~0.1-0.8 theta_cp) are dragged sideways at up to "
-                          "~5e-5 m/s at t = 4 s by the decaying clear-fluid circulation above the bed (~5e-4 m/s): "
-                          "the isotropic particle stress of Eq. 16 has no shear resistance, so nothing holds a "
-                          "resting grain against a tangential drag. Rows below the surface are at < 5e-7 m/s.",
-                   strict=True)
 def test_settled_bed_parcels_at_rest(settled):
+    """Every parcel, bed surface included, at < 1e-6 m/s: the grains on the surface, dragged sideways by the
+    decaying circulation of the clear fluid above, are held by bed friction (Coulomb, mu_b = 0.543 x their
+    submerged weight; without it they move at up to ~5e-5 m/s at t = 4 s)."""
     speed = np.hypot(settled.parcels.u, settled.parcels.v)
     assert speed.max() < 1e-6
 

@@ -91,7 +91,9 @@ def test_slurry_viscosity_limits():
 
 
 @pytest.mark.parametrize("field, value", [("theta_cp", 1.2), ("drag_law", "stokes"), ("drag_iterations", 0),
-                                          ("restitution", -0.1), ("viscosity_law", "linear"), ("P_s", 0.0)])
+                                          ("restitution", -0.1), ("viscosity_law", "linear"), ("P_s", 0.0),
+                                          ("bed_friction", -0.5), ("friction_volume_fraction", 0.0),
+                                          ("friction_volume_fraction", 1.0)])
 def test_params_reject_bad_values_naming_the_field(field, value):
     with pytest.raises(SceneError, match=f"mppic.{field}"):
         MppicParams(**{field: value})
