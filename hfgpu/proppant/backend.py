@@ -25,7 +25,7 @@ a gather and its exchange: it reorders the parcels); on the CPU they need no ato
 parcel block), on a GPU sorted parcels need few atomics. Results do not depend on the order beyond
 round-off. The Taichi backend reuses its output arrays (seen, D_p) once nothing refers to them any more.
 
-The fluid engineer registers ``momentum_predictor`` on both classes below (marked place).
+Both backends also carry the fluid's explicit ``momentum_predictor`` (Eq. 26 / 49).
 """
 
 from __future__ import annotations
@@ -68,7 +68,6 @@ class NumpyBackend:
         """Interphase momentum transfer per unit volume at faces (Eq. 39)."""
         return ref.exchange(parcels, seen, drag, frame, width)
 
-    # --- fluid engineer: register momentum_predictor here (same signature as on TaichiBackend) ---
     def momentum_predictor(self, u0: np.ndarray, v0: np.ndarray, p: np.ndarray, width0: np.ndarray,
                            theta_f0: np.ndarray, width: np.ndarray, theta_f: np.ndarray, mu: np.ndarray,
                            force_x: np.ndarray, force_z: np.ndarray, rho: float, dx: float, dz: float,
@@ -198,7 +197,6 @@ class TaichiBackend:
         wxf, wzf = face_widths(width)
         return ref.per_face_volume(sums[0], frame, wxf), ref.per_face_volume(sums[1], frame, wzf)
 
-    # --- fluid engineer: register momentum_predictor here (same signature as on NumpyBackend) ---
     def momentum_predictor(self, u0: np.ndarray, v0: np.ndarray, p: np.ndarray, width0: np.ndarray,
                            theta_f0: np.ndarray, width: np.ndarray, theta_f: np.ndarray, mu: np.ndarray,
                            force_x: np.ndarray, force_z: np.ndarray, rho: float, dx: float, dz: float,
