@@ -22,6 +22,10 @@ class FractureNumerics:
     leakoff_width_fraction: width scale of the leak-off positivity ramp (leakoff.available_fraction) as a
         fraction of the step's Carter demand; a cell never leaks fluid it does not hold.
     max_step_growth: largest ratio of one time step to the previous one.
+    tip_velocity: V of the viscous tip asymptote: "fluid" (velocity through the tip element's inner face) or
+        "front" (at least the mean front speed through the tip element, Eq. 34), see front.tip_velocity.
+    partial_tip_cells: spread a newly opened cell's Carter opening time over the time the front takes to
+        cross it (its parent's crossing time, Eq. 34), so leak-off follows the wetted part of the cell.
     """
 
     time_step_relaxation: float = 0.5
@@ -34,6 +38,8 @@ class FractureNumerics:
     tip_asymptote: str = "km"
     leakoff_width_fraction: float = 0.01
     max_step_growth: float = 1.5
+    tip_velocity: str = "front"
+    partial_tip_cells: bool = True
 
 
 def parse_fracture_numerics(t: Table) -> FractureNumerics:
@@ -53,6 +59,8 @@ def parse_fracture_numerics(t: Table) -> FractureNumerics:
         leakoff_width_fraction=t.number("leakoff_width_fraction", d.leakoff_width_fraction, minimum=0.0,
                                         maximum=1.0, exclusive_minimum=True),
         max_step_growth=t.number("max_step_growth", d.max_step_growth, minimum=1.0, maximum=10.0),
+        tip_velocity=t.choice("tip_velocity", ("fluid", "front"), d.tip_velocity),
+        partial_tip_cells=t.boolean("partial_tip_cells", d.partial_tip_cells),
     )
     t.finish()
     return numerics

@@ -10,9 +10,11 @@ viscosity (M-vertex) asymptote of Desroches et al. (1994), w = beta_m (mu' V / E
 beta_m = 2^(1/3) 3^(5/6) (REFERENCE.md 1.3): a cheap envelope of the universal K-M asymptote of Dontsov &
 Peirce (2015), exact at both ends. Olson's 0.806 multiplies the toughness term only: it was derived for
 the s^(1/2) profile of constant-DD tip elements, not for the s^(2/3) viscous one. V is the fluid velocity through
-the tip element's inner face towards the candidate cell (at the tip, fluid and front move together).
-Leak-off needs no extra rule: a new cell's Carter demand (tau = its opening time) keeps it nearly empty
-until the inflow exceeds it. Opened cells never close, so the front cannot retreat.
+the tip element's inner face towards the candidate cell (at the tip, fluid and front move together), or
+with ``tip_velocity = "front"`` at least the mean front speed h / (t - t_reached) through the tip element.
+Leak-off needs no extra rule: a new cell's Carter demand keeps it nearly empty until the inflow exceeds it
+(with ``partial_tip_cells`` the demand follows the wetted part of the cell, see simulator.py). Opened cells
+never close, so the front cannot retreat.
 
 Sub-grid front. The same asymptote, inverted at the cells on the fracture's edge, locates the front
 inside the grid: the simulator's front summary takes, for each edge cell, its centre's distance from the
@@ -39,11 +41,13 @@ DIRECTIONS = ((0, 1), (0, -1), (1, 0), (-1, 0))
 
 @dataclass(frozen=True)
 class TipModel:
-    """Material constants of the tip asymptote: E', mu' = 12 mu and the asymptote's name."""
+    """Material constants of the tip asymptote: E', mu' = 12 mu, the asymptote's name and the tip-velocity
+    estimate (``tip_velocity``)."""
 
     e_prime: float
     mu_prime: float
     mode: str  # "olson" or "km"
+    velocity: str = "fluid"  # "fluid" or "front" (see tip_velocity)
 
 
 def tip_width(model: TipModel, k_prime: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -65,6 +69,17 @@ def invert_tip(model: TipModel, k_prime: np.ndarray, w: np.ndarray, v: np.ndarra
             scale = BETA_M * np.cbrt(model.mu_prime * np.maximum(v, 0.0) / model.e_prime)
             s = np.minimum(s, np.where(scale > 0.0, (w / np.where(scale > 0, scale, 1.0)) ** 1.5, np.inf))
     return s
+
+
+def tip_velocity(model: TipModel, v_fluid: np.ndarray, h: float, t: float, reached: np.ndarray) -> np.ndarray:
+    """Velocity V of the viscous tip asymptote: the fluid velocity through the tip element's inner face, or
+    with ``velocity = "front"`` at least the mean front speed since the front reached the tip element,
+    h / (t - t_reached) (Eq. 34's V_T: the front must cross the element to open the next cell)."""
+    if model.velocity == "fluid":
+        return v_fluid
+    with np.errstate(invalid="ignore"):
+        v_front = h / np.maximum(t - reached, 1e-300)
+    return np.fmax(v_fluid, np.where(np.isfinite(reached), v_front, 0.0))
 
 
 def _shift(a: np.ndarray, dk: int, di: int, fill) -> np.ndarray:
@@ -99,7 +114,7 @@ def cells_to_open(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndar
     speed = np.full(active.shape, np.nan)
     for dk, di in DIRECTIONS:
         h = dz if dk else dx
-        v = inflow_velocity(active, w, p, h, dk, di, model.mu_prime)
+        v = tip_velocity(model, inflow_velocity(active, w, p, h, dk, di, model.mu_prime), h, t, reached)
         ok = active & (w >= tip_width(model, k_prime, np.full(w.shape, 0.5 * h), v))
         # candidate = the cell on the (dk, di) side of a triggering tip element
         cand = _shift(ok, dk, di, False) & ~active

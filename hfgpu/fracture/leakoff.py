@@ -20,9 +20,27 @@ from __future__ import annotations
 import numpy as np
 
 
-def carter_volume(c_prime: np.ndarray, tau: np.ndarray, t0: float, t1: float) -> np.ndarray:
-    """Leaked volume per unit area over [t0, t1]: 2 C' (sqrt(t1 - tau) - sqrt(max(t0, tau) - tau)) (Eq. 29)."""
+def carter_volume(c_prime: np.ndarray, tau: np.ndarray, t0: float, t1: float,
+                  filled: np.ndarray | None = None) -> np.ndarray:
+    """Leaked volume per unit area over [t0, t1]: 2 C' (sqrt(t1 - tau) - sqrt(max(t0, tau) - tau)) (Eq. 29).
+
+    With ``filled`` (partially filled tip cells), the front crosses the cell between tau and ``filled``:
+    the opening time is spread uniformly over the cell's area, tau(x) in [tau, filled], and the cell-mean
+    is the exact average of Eq. 29's integral over it,
+    2 C' (2/3) [F(t1) - F(t0)] / (filled - tau), F(t) = (t - tau)_+^(3/2) - (t - filled)_+^(3/2).
+    """
     tau = np.asarray(tau, dtype=float)
+    if filled is not None:
+        span = np.asarray(filled, dtype=float) - tau
+        spread = span > 0.0
+        if spread.any():
+            safe = np.where(spread, span, 1.0)
+
+            def f(t):
+                return np.maximum(t - tau, 0.0) ** 1.5 - np.maximum(t - tau - safe, 0.0) ** 1.5
+
+            mean = 2.0 * np.asarray(c_prime, dtype=float) * (2.0 / 3.0) * (f(t1) - f(t0)) / safe
+            return np.where(spread, mean, carter_volume(c_prime, tau, t0, t1))
     start = np.maximum(t0, tau)
     open_ = t1 > tau
     out = 2.0 * np.asarray(c_prime, dtype=float) * (np.sqrt(np.maximum(t1 - tau, 0.0))

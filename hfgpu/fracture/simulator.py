@@ -14,6 +14,14 @@ cells whose centres lie inside it). t0 is the latest of the times at which the f
 mechanism controls early growth -- and the cells' opening times follow that vertex's R ~ t^a
 (tau = t0 (r / R0)^(1/a)). The cells hold the volume injected by t0 less the Carter volume leaked since
 their opening times (at most 90 % of it), in the shape a uniform net pressure gives (C w = const).
+
+Coarsening. With ``mesh.max_cells_across`` set, the grid is merged 3x3 (coarsen.py; odd so the source
+stays cell-centred) each time the footprint spans more cells than that along x or z; volume is carried
+exactly, so the balance holds across the merge, and the active-cell count stays bounded.
+
+Partially filled tip cells (``partial_tip_cells``). A newly opened cell records, besides its opening time,
+the time the front will have crossed it (its parent's crossing time, Eq. 34); its Carter leak-off is the
+exact average over opening times spread uniformly between the two (leakoff.carter_volume).
 """
 
 from __future__ import annotations
@@ -25,9 +33,10 @@ import numpy as np
 
 from ..errors import SceneError, SimulationError
 from ..records import BalanceRecord, FractureSnapshot, GridFrame
+from .coarsen import coarsen
 from .config import FractureNumerics
 from .elasticity import ElasticityOperator
-from .front import DIRECTIONS, TipModel, cells_to_open, edge_cells, invert_tip
+from .front import DIRECTIONS, TipModel, cells_to_open, edge_cells, invert_tip, tip_velocity
 from .leakoff import carter_volume
 from .lubrication import build_faces
 from .mesh import GROW, Grid
@@ -45,9 +54,6 @@ def _check_scene(scene) -> None:
     if first.rate <= 0.0:
         raise SceneError("injection.schedule[0].rate", first.rate,
                          "the first stage must inject (rate > 0) to start a fracture")
-    if scene.mesh.max_cells_across is not None:
-        raise SceneError("mesh.max_cells_across", scene.mesh.max_cells_across,
-                         "coarsening is not implemented in the fracture engine yet; leave it out")
 
 
 def initial_time(e_prime: float, mu_prime: float, k_prime: float, c_prime: float, q: float,
@@ -78,7 +84,7 @@ class _Engine:
         self.e_prime = rock.plane_strain_modulus
         self.mu_prime = 12.0 * scene.fluid.viscosity
         self.schedule = inj.schedule
-        self.tip = TipModel(self.e_prime, self.mu_prime, numerics.tip_asymptote)
+        self.tip = TipModel(self.e_prime, self.mu_prime, numerics.tip_asymptote, numerics.tip_velocity)
         self.op = ElasticityOperator(self.dx, self.dz, self.e_prime)
         h = max(self.dx, self.dz)
         r0 = numerics.initial_radius_cells * h
@@ -100,6 +106,7 @@ class _Engine:
         act = g["active"]
         g["opened"][act] = self.t0 * (r[act] / r0) ** (1.0 / power)
         g["reached"][act] = g["opened"][act]
+        g["filled"][act] = g["opened"][act]
         self._rebuild()
         leaked = self.area * carter_volume(self.cprime_a, g["opened"][act], 0.0, self.t0)
         injected = self.schedule.volume(self.t0)
@@ -112,7 +119,7 @@ class _Engine:
         self.t = self.t0
         self.v_front = power * r0 / self.t0
         self.t_front = self.t0
-        self.steps = self.newton_iterations = self.retries = 0
+        self.steps = self.newton_iterations = self.retries = self.coarsenings = 0
         self.max_balance_error = 0.0
 
     def _properties(self) -> None:
@@ -142,10 +149,11 @@ class _Engine:
         sel = (self.rows, self.cols)
         w_old = g["w"][sel]
         tau = g["opened"][sel]
+        filled = g["filled"][sel] if self.num.partial_tip_cells else None
         for attempt in range(self.num.max_step_retries + 1):
             source = np.zeros(w_old.size)
             source[self.inj] = self.schedule.mean_rate(self.t, self.t + dt) * dt
-            demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt)
+            demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt, filled)
             w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
             prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
                                demand, w_eps, 1e-3 * float(w_old.max()))
@@ -181,6 +189,7 @@ class _Engine:
         g.fields["active"] = g["active"] | to_open
         g["reached"][to_open] = self.t
         g["opened"][to_open] = self.t
+        g["filled"][to_open] = self.t + min(self.dx, self.dz) / speed[to_open]
         g["w"][to_open] = 0.0
         self.v_front = float(np.nanmax(speed))
         self.t_front = self.t
@@ -188,6 +197,35 @@ class _Engine:
         g.ensure_margin()
         if g.shape != before:
             self._properties()
+        self._rebuild()
+        self._coarsen_if_wide()
+
+    def _coarsen_if_wide(self) -> None:
+        """Continue on a 3x3 coarser grid (coarsen.py) once the footprint spans more than
+        ``mesh.max_cells_across`` cells along x or z. Fluid volume is carried exactly (w = sum of the
+        children's w / 9), pressure as the mean, opening and front-arrival times as the earliest child's."""
+        cap = self.scene.mesh.max_cells_across
+        if cap is None or max(np.ptp(self.ix), np.ptp(self.iz)) + 1 <= cap:
+            return
+        g, sel = self.grid, (self.rows, self.cols)
+        c = coarsen(self.ix, self.iz)
+        f = c.factor
+        half = int(max(np.abs(c.ix).max(), np.abs(c.iz).max())) + GROW
+        new = Grid.around_injection(f * self.dx, f * self.dz, g.x_inj, g.z_inj, half)
+        at = (c.iz + half, c.ix + half)
+        new["active"][at] = True
+        new["w"][at] = c.width(g["w"][sel])
+        new["p"][at] = c.mean(g["p"][sel])
+        new["leak_rate"][at] = c.total(g["leak_rate"][sel]) / f**2
+        new["opened"][at] = c.earliest(g["opened"][sel])
+        new["reached"][at] = c.earliest(g["reached"][sel])
+        new["filled"][at] = -c.earliest(-g["filled"][sel])
+        self.grid = new
+        self.dx, self.dz = new.dx, new.dz
+        self.area = self.dx * self.dz
+        self.op = ElasticityOperator(self.dx, self.dz, self.e_prime)
+        self.coarsenings += 1
+        self._properties()
         self._rebuild()
 
     def next_dt(self, dt_prev: float) -> float:
@@ -241,6 +279,7 @@ class _Engine:
                 if 0 <= kb < nz and 0 <= ib < nx and act[kb, ib]:
                     wf = max(w[kb, ib], 0.0) + max(w[k, i], 0.0)
                     v = max(wf**2 / (4.0 * self.mu_prime) * (p[kb, ib] - p[k, i]) / h, 0.0)
+                v = float(tip_velocity(self.tip, np.array(v), h, self.t, np.array(g["reached"][k, i])))
                 s = min(float(invert_tip(self.tip, np.array(self.kprime_box[k, i]), np.array(w[k, i]),
                                          np.array(v))), h)
                 best = max(best, s)
@@ -267,8 +306,10 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None) -> di
 
     Calls ``sink.fracture_balance(BalanceRecord)`` after every accepted step and
     ``sink.fracture_snapshot(FractureSnapshot)`` at every ``output.every`` and at the end; ``progress(t)``
-    after each step. Returns a summary: time, steps, newton_iterations, retries, cells, the sub-grid front
-    (radius, radius_min, radius_max, area_radius, up, down, left, right), w_inlet, p_inlet, the final
+    after each step. With ``mesh.max_cells_across`` set, the grid is merged 3x3 each time the footprint
+    spans more cells than that along x or z (snapshots then carry the coarser frame). Returns a summary:
+    time, steps, newton_iterations, retries, coarsenings, dx, dz (final cell sizes), cells, the sub-grid
+    front (radius, radius_min, radius_max, area_radius, up, down, left, right), w_inlet, p_inlet, the final
     balance (injected, stored, leaked) and max_balance_error (relative).
     """
     _check_scene(scene)
@@ -298,6 +339,7 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None) -> di
     inj = (eng.rows[eng.inj], eng.cols[eng.inj])
     final = eng.balance()
     return dict(time=eng.t, t0=eng.t0, steps=eng.steps, newton_iterations=eng.newton_iterations,
-                retries=eng.retries, cells=int(g["active"].sum()), w_inlet=float(g["w"][inj]),
+                retries=eng.retries, coarsenings=eng.coarsenings, dx=eng.dx, dz=eng.dz,
+                cells=int(g["active"].sum()), w_inlet=float(g["w"][inj]),
                 p_inlet=float(g["p"][inj]), injected=final.injected, stored=final.stored,
                 leaked=final.leaked, max_balance_error=eng.max_balance_error, **eng.front())

@@ -30,3 +30,17 @@ def test_available_fraction_is_a_monotone_ramp_from_zero_to_one():
     h = 1e-12
     fd = (available_fraction(w + h, np.full(5, 1e-6))[0] - available_fraction(w - h, np.full(5, 1e-6))[0]) / (2 * h)
     np.testing.assert_allclose(dg, fd, rtol=1e-4)
+
+
+@pytest.mark.parametrize("tau, filled, t0, t1", [(0.0, 2.0, 1.0, 3.0), (0.0, 2.0, 2.5, 3.0), (1.0, 4.0, 0.0, 2.0),
+                                                 (0.5, 0.5, 1.0, 2.0)])
+def test_partially_filled_cell_averages_the_rate_over_its_opening_times(tau, filled, t0, t1):
+    """Opening time spread uniformly over [tau, filled]: the cell mean of Eq. 29's integral, by quadrature."""
+    c_prime = 3e-4
+
+    def point(tp):
+        return quad(lambda t: c_prime / np.sqrt(t - tp), max(t0, tp), t1)[0] if t1 > tp else 0.0
+
+    expected = quad(point, tau, filled)[0] / (filled - tau) if filled > tau else point(tau)
+    got = carter_volume(np.array([c_prime]), np.array([tau]), t0, t1, np.array([filled]))[0]
+    assert got == pytest.approx(expected, rel=1e-6, abs=1e-15)

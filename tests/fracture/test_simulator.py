@@ -99,6 +99,10 @@ def test_bad_input_is_rejected_before_work_starts():
                  ListSink())
     with pytest.raises(SceneError, match="fracture.tip_asymptote"):
         load_scene(scene_text(fracture='[fracture]\ntip_asymptote = "magic"'))
+    with pytest.raises(SceneError, match="fracture.tip_velocity"):
+        load_scene(scene_text(fracture='[fracture]\ntip_velocity = "sonic"'))
+    with pytest.raises(SceneError, match="fracture.partial_tip_cells"):
+        load_scene(scene_text(fracture='[fracture]\npartial_tip_cells = 3'))
     with pytest.raises(SceneError, match="fracture.initial_radius_cells"):
         simulate(scene(end_time="0.001 s", cell="1 m"), ListSink())
 
