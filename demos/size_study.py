@@ -1,6 +1,6 @@
 """Proppant size study of the paper's section 6.2 (Figs. 15-18): the field case with 30/50, 40/70 and 100 mesh
-sand, from one command; prints a table of created area, propped area, propped fraction, packed fraction and
-screen-out flags.
+sand, from one command; prints a table of created area, propped area, propped fraction, packed fraction,
+screen-out flags and the share of the scheduled solids held back at the packed perforation (screen-out).
 
     python demos/size_study.py [--scaled] [--out size_output] [--sizes 30/50 40/70 "100 mesh"] [--backend numpy|taichi]
 
@@ -16,7 +16,7 @@ from pathlib import Path
 
 from field_case import load, report  # the demos folder is on sys.path when run as a script
 
-from hfgpu import run
+from hfgpu import open_results, run
 
 PAPER = "paper (section 6.2): propped 30.9 % of the area for 30/50, 100 mesh +59.3 % over 30/50; packed " \
         "fraction at 3600 s ~0.71 (30/50) to ~0.18 (100 mesh)"
@@ -38,12 +38,15 @@ def main() -> None:
             status = "complete"
         except Exception as exc:  # noqa: BLE001 -- the file keeps every snapshot written before the failure
             status = f"failed: {type(exc).__name__}: {exc}"
-        rows.append((size, report(path), status))
+        summary = open_results(path).summary
+        held = summary.get("proppant_screened_out", 0.0) / max(summary.get("proppant_injected", 0.0), 1e-300)
+        rows.append((size, {**report(path), "held_back": held}, status))
     print(f"{'size':>8} {'t end s':>8} {'created m^2':>12} {'propped m^2':>12} {'propped %':>10} {'packed':>7} "
-          f"{'screen-out':>10}  status")
+          f"{'screen-out':>10} {'held back %':>11}  status")
     for size, r, status in rows:
         print(f"{size:>8} {r['time']:8.1f} {r['created_area']:12.0f} {r['propped_area']:12.0f} "
-              f"{100 * r['propped_fraction']:10.1f} {r['packed'][-1][1]:7.2f} {r['screen_out_cells']:10d}  {status}")
+              f"{100 * r['propped_fraction']:10.1f} {r['packed'][-1][1]:7.2f} {r['screen_out_cells']:10d} "
+              f"{100 * r['held_back']:11.1f}  {status}")
     base = rows[0][1]["propped_area"]
     for size, r, _ in rows[1:]:
         if base > 0:

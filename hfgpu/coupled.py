@@ -17,6 +17,12 @@ cell holds proppant and its width is below ``bridging_factor`` x the largest par
 criterion of :func:`hfgpu.coupling.bridging_risk`); the summary has ``screen_out_cells`` (at the end),
 ``screen_out_cells_max`` and ``screen_out_first_time`` (NaN when never).
 
+Screen-out at the perforation (handled): the inlet places proppant only into cells below close packing; what
+cannot enter is held back and counted (``proppant_screened_out`` [m^3] in the summary and ``screened_out`` in
+the solid balance, injected = in_domain + outflow + screened_out; ``proppant_screen_out_time`` is when it
+first happened, on the scene's clock, NaN when never) and a RuntimeWarning line says so. The fracture does not
+feel it (one-way coupling): its pressure and growth assume all the slurry enters.
+
 ``[coupling]`` keys (all optional): ``fracture_every`` (default end_time / 60), ``cell_size`` (one length or
 [dx, dz]; default the fracture cells), ``inlet_inner_radius`` (default 0), ``inlet_radius`` (outer radius of the
 annulus, default 1.5 x the larger proppant cell size: the injection cell and its eight neighbours),
@@ -37,7 +43,7 @@ from .coupling import FractureHistory, bridging_risk, proppant_frame
 from .errors import SceneError
 from .fracture.simulator import simulate as simulate_fracture
 from .proppant.config import Geometry, Port
-from .proppant.simulator import ProppantSimulation
+from .proppant.simulator import ProppantSimulation, warn_screen_out
 from .records import GridFrame, ProppantSnapshot, SolidBalanceRecord
 from .scene import Scene, Schedule
 from .scene_reader import Table
@@ -235,6 +241,8 @@ def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None =
     sim._particle_subloop = timings.wrap("parcels", sim._particle_subloop)
     shift = _ProppantShift(sink, start, scene.proppant.params.bridging_factor, timings)
     proppant = sim.run(shift, None if progress is None else (lambda t: progress(t + start)))
+    warn_screen_out(proppant, scene.proppant.params.theta_cp, offset=start)
+    proppant["screen_out_time"] += start
     summary = {f"fracture_{k}": v for k, v in fracture.items()}
     summary.update({f"proppant_{k}": v for k, v in proppant.items()}, proppant_time=proppant["time"] + start)
     summary.update(proppant_start=start, proppant_nx=shape[1], proppant_nz=shape[0], proppant_dx=frame.dx,

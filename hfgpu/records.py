@@ -78,9 +78,13 @@ class ProppantSnapshot:
 
 @dataclass(frozen=True)
 class SolidBalanceRecord:
-    """Proppant solid volume [m^3]: injected = in_domain + outflow (to round-off)."""
+    """Proppant solid volume [m^3]: injected = in_domain + outflow + screened_out (to round-off).
+
+    screened_out: solid volume scheduled at the inlets but held back because their cells were packed
+    (screen-out, :mod:`hfgpu.proppant.injection`)."""
 
     time: float
     injected: float
     in_domain: float
     outflow: float
+    screened_out: float = 0.0

@@ -7,7 +7,7 @@ Layout (docs/results-format.md is the full contract; extend, never rename)::
     /fracture/snapshots/000000 ...   attrs time, dx, dz, x0, z0; width, pressure, leakoff_rate, opening_time, extras
     /fracture/balance       time, injected, stored, leaked (1-D, appended)
     /proppant/snapshots/000000 ...   attrs time, dx, dz, x0, z0, n_parcels; per-parcel and grid datasets
-    /proppant/balance       time, injected, in_domain, outflow (1-D, appended)
+    /proppant/balance       time, injected, in_domain, outflow, screened_out (1-D, appended)
     /summary                attrs status, message, and the simulator's scalar summary values
 
 Integrity: the file is open only while a snapshot is written. A snapshot is built under a temporary
@@ -40,6 +40,7 @@ INCOMPLETE = "_incomplete"
 #: Units of every dataset name the writer knows (SI; "1" is dimensionless, "" is text or a label).
 UNITS = {
     "time": "s", "injected": "m^3", "stored": "m^3", "leaked": "m^3", "in_domain": "m^3", "outflow": "m^3",
+    "screened_out": "m^3",
     "width": "m", "pressure": "Pa", "leakoff_rate": "m/s", "opening_time": "s",
     "net_pressure": "Pa", "min_stress": "Pa", "toughness": "Pa m^0.5", "leakoff_coefficient": "m/s^0.5",
     "x": "m", "z": "m", "u": "m/s", "v": "m/s", "radius": "m", "density": "kg/m^3", "particles": "1",
@@ -51,7 +52,7 @@ UNKNOWN_UNITS = "unspecified"
 
 FRACTURE_FIELDS = ("width", "pressure", "leakoff_rate", "opening_time")
 FRACTURE_BALANCE = ("time", "injected", "stored", "leaked")
-PROPPANT_BALANCE = ("time", "injected", "in_domain", "outflow")
+PROPPANT_BALANCE = ("time", "injected", "in_domain", "outflow", "screened_out")
 _BALANCE_FLUSH_ROWS = 4096
 _COMPRESS_ABOVE = 4096  # elements; smaller arrays are stored plainly
 

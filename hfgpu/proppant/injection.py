@@ -5,6 +5,14 @@ Q(t) delta(x) is the fluid part here; the solids enter as parcels). Each inlet i
 :class:`hfgpu.proppant.config.Port` mapped onto the grid) receiving its share of the rate. Parcels are emitted
 with exactly the scheduled solid volume: an inlet keeps the solid volume not yet emitted and the diameter of the
 next parcel, and emits parcels of ``particles_per_parcel`` particles while that volume covers the next one.
+
+Screen-out: proppant cannot enter a cell packed beyond close packing (theta_cp, the singular limit of the
+paper's interparticle stress, Eq. 16).
+``emit`` takes the solid volume each cell can still take, ``room`` = theta_cp V_cell - (solid volume there,
+the scatter of Eq. 38); a parcel goes to a random position of its inlet where its bilinear share (Eq. 37) fits
+the room of every cell it touches, and a parcel that fits nowhere (after a few random positions) is held back:
+its volume is added to ``screened_out`` (it counts as injected, never placed), so that
+injected = in_domain + outflow + screened_out stays exact.
 """
 
 from __future__ import annotations
@@ -17,8 +25,11 @@ import numpy as np
 from ..errors import SceneError
 from ..records import GridFrame
 from .config import Port, ProppantClass
+from .interpolation import active_nodes, weights
 
 PARCEL_KEYS = ("x", "z", "u", "v", "radius", "density", "particles", "state", "class_id")
+#: Random positions in its inlet a parcel is tried at before it is held back (screen-out).
+PLACEMENT_TRIES = 8
 
 
 def port_cells(port: Port, frame: GridFrame, width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -142,6 +153,7 @@ class Injector:
         self.rate = rate
         self.loadings = loadings
         self.rng = rng
+        self.screened_out = 0.0  # solid volume held back at packed inlets [m^3]
         total = sum(p.share for p in ports)
         self.inlets = [_Inlet(k, i, p.share / total, np.zeros(len(classes)), np.full(len(classes), np.nan))
                        for p, (k, i) in zip(ports, ports_to_cells(ports, frame, width, "geometry.inlets"))]
@@ -162,9 +174,16 @@ class Injector:
             np.add.at(out, (inlet.k, inlet.i), q * inlet.share / inlet.k.size)
         return out
 
-    def emit(self, t0: float, t1: float) -> dict[str, np.ndarray]:
-        """Parcels entering during (t0, t1], placed uniformly at random in their inlet's cells, at rest."""
+    def emit(self, t0: float, t1: float, room: np.ndarray | None = None,
+             width: np.ndarray | None = None) -> dict[str, np.ndarray]:
+        """Parcels entering during (t0, t1], placed uniformly at random in their inlet's cells, at rest.
+
+        ``room`` (nz, nx): solid volume each cell can still take [m^3] (None: unlimited), on the grid of
+        ``width`` (the step's width); a parcel is placed only where its bilinear share (Eq. 37) fits the room of
+        every cell it lands on (up to PLACEMENT_TRIES random positions in its inlet), else it is held back
+        (``screened_out``). ``room`` (float64) is reduced in place by the parcels placed."""
         q = self.rate(t0, t1) * (t1 - t0)
+        mask = None if room is None else active_nodes(width)[0]
         batches = []
         for c, fraction in self.loadings(0.5 * (t0 + t1)):
             if fraction <= 0.0 or q <= 0.0:
@@ -175,10 +194,40 @@ class Injector:
                 inlet.owed[c] += fraction * q * inlet.share
                 d = self._draw(inlet, c, cls, ppp)
                 if d.size:
-                    cell = self.rng.integers(0, inlet.k.size, d.size)
-                    x, z = uniform_points(self.rng, self.frame, inlet.k, inlet.i, cell)
+                    x, z = uniform_points(self.rng, self.frame, inlet.k, inlet.i,
+                                          self.rng.integers(0, inlet.k.size, d.size))
+                    if room is not None:
+                        placed = self._fit(inlet, x, z, ppp * np.pi / 6.0 * d**3, room, mask)
+                        x, z, d = x[placed], z[placed], d[placed]
                     batches.append(make_batch(x, z, d, cls.density, ppp, c))
         return concat_batches(batches)
+
+    def _fit(self, inlet: _Inlet, x: np.ndarray, z: np.ndarray, volume: np.ndarray, room: np.ndarray,
+             mask: np.ndarray) -> np.ndarray:
+        """Which parcels (at x, z, of solid volume ``volume``) fit the room; moves (in place) those whose
+        first position does not fit to another random position of the inlet, up to PLACEMENT_TRIES times,
+        and adds the volume of the ones that never fit to ``screened_out``. ``room`` is reduced in place."""
+        k, i, w = weights(x, z, self.frame, "cell", mask)
+        need = np.zeros_like(room)
+        np.add.at(need, (k, i), volume[:, None] * w)
+        if np.all(need <= room):  # all fit at once (no screen-out near)
+            room -= need
+            return np.ones(x.size, dtype=bool)
+        placed = np.zeros(x.size, dtype=bool)
+        for p in range(x.size):
+            kp, ip, wp = k[p], i[p], w[p]
+            for _ in range(PLACEMENT_TRIES):
+                if np.all(volume[p] * wp <= room[kp, ip]):
+                    np.subtract.at(room, (kp, ip), volume[p] * wp)
+                    placed[p] = True
+                    break
+                xs, zs = uniform_points(self.rng, self.frame, inlet.k, inlet.i,
+                                        self.rng.integers(0, inlet.k.size, 1))
+                x[p], z[p] = xs[0], zs[0]
+                kp, ip, wp = (a[0] for a in weights(xs, zs, self.frame, "cell", mask))
+            if not placed[p]:
+                self.screened_out += float(volume[p])
+        return placed
 
     def _draw(self, inlet: _Inlet, c: int, cls: ProppantClass, ppp: float) -> np.ndarray:
         """Diameters of the parcels whose volume the inlet owes, keeping the first one that does not fit."""

@@ -15,9 +15,12 @@ particle sub-step; a step whose Courant number comes out above C_max is undone, 
 This is the cycle scatter -> fluid -> particles of the paper entered at the particles: each fluid step sees
 the force of the particle sub-loop over the same interval.
 
-Solid balance: ``injected`` is all solid volume placed in the domain (the initial suspension plus the inlets),
-``in_domain`` the parcels' volume, ``outflow`` what left through outlets; injected = in_domain + outflow to
-round-off. A growing fracture can drive the loop through ``width_field(t) -> (width, leakoff)`` on the grid
+Solid balance: ``injected`` is all solid volume scheduled into the domain (the initial suspension plus the
+inlets), ``in_domain`` the parcels' volume, ``outflow`` what left through outlets, ``screened_out`` what the
+inlets held back because their cells were packed to theta_cp (a screen-out at the perforation: proppant cannot
+enter a packed, bridged zone; :class:`hfgpu.proppant.injection.Injector`); injected = in_domain + outflow +
+screened_out to round-off; :func:`simulate` ends with a RuntimeWarning line when any was held back (first
+time, volume). A growing fracture can drive the loop through ``width_field(t) -> (width, leakoff)`` on the grid
 (cells that open join the fluid grid; leak-off [m/s per unit area, both faces] is the sink s_l of Eq. 7).
 
 The drag part of F is also handed to the fluid step as beta = sum n rho_p V_p D_p I / V_face, so that the
@@ -30,6 +33,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import warnings
 from dataclasses import dataclass
 from typing import Callable
 
@@ -104,8 +108,9 @@ class ProppantSimulation:
     """State and stepping of one MP-PIC run; :func:`simulate` drives it to the end time.
 
     Attributes a caller may read: ``time``, ``grid``, ``parcels`` (:class:`Parcels`), ``fluid`` (the fluid
-    solver's state), ``injected``, ``outflow`` [m^3] (solids), ``fluid_totals`` (the fluid volumes of
-    FLUID_VOLUMES summed over the steps; injected + opened = stored + leaked + outflow). ``add_parcels`` places extra parcels (counted as
+    solver's state), ``injected``, ``outflow``, ``screened_out`` [m^3] (solids), ``screen_out_time`` [s] (first
+    hold-back, NaN when none), ``fluid_totals`` (the fluid volumes of FLUID_VOLUMES summed over the steps;
+    injected + opened = stored + leaked + outflow). ``add_parcels`` places extra parcels (counted as
     injected), e.g. a single test particle.
     """
 
@@ -131,6 +136,7 @@ class ProppantSimulation:
         self.parcels = Parcels.empty()
         self.injected = 0.0
         self.outflow = 0.0
+        self.screen_out_time = math.nan  # start of the first step whose inlets held proppant back
         self.add_parcels(initial_suspension(setup.classes, self.grid.frame, self.grid.width,
                                             self.particles_per_parcel, self.rng))
         self.injector = self._make_injector(schedule)
@@ -203,8 +209,10 @@ class ProppantSimulation:
             if self.width_field is not None:
                 self._set_width(t0 + dt)
                 self.solver.set_grid(self.grid)
+            if not (dt > 0.0 and t0 + dt > t0):
+                raise SimulationError(f"zero-length time step (dt = {dt:g} s)", time=t0)
             if self.injector is not None:
-                self.add_parcels(self.injector.emit(t0, t0 + dt))
+                self._inject(t0, t0 + dt)
             force = self._particle_subloop(dt, t0)
             self.moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
             sources = (self.injector.fluid_sources(t0, t0 + dt) if self.injector is not None
@@ -234,6 +242,23 @@ class ProppantSimulation:
                         continuity_residual=info.continuity_residual, courant=info.courant,
                         parcels=self.parcels.n, retries=retry)
 
+    def _inject(self, t0: float, t1: float) -> None:
+        """Add the inlets' parcels for (t0, t1] into the room left below close packing, theta_cp V_cell minus
+        the solid volume of the scatter (Eq. 38) on the step's width; what cannot enter is screened out."""
+        moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
+        room = np.maximum(self.params.theta_cp * self.grid.cell_volume - moments.solid_volume, 0.0)
+        held = self.injector.screened_out
+        self.add_parcels(self.injector.emit(t0, t1, room=room, width=self.grid.width))
+        held = self.injector.screened_out - held
+        self.injected += held
+        if held > 0.0 and math.isnan(self.screen_out_time):
+            self.screen_out_time = t0
+
+    @property
+    def screened_out(self) -> float:
+        """Solid volume the inlets held back at packed cells so far [m^3]."""
+        return self.injector.screened_out if self.injector is not None else 0.0
+
     def _fluid_theta_p(self) -> np.ndarray:
         """theta_p handed to the fluid, kept below 1 (only an over-packed cell, where the packing limiter
         failed, reaches it). Not capped at close packing: the fluid's storage term (theta_f w)^n - (theta_f
@@ -243,10 +268,10 @@ class ProppantSimulation:
     def _save(self) -> tuple:
         """What a step changes before its Courant check, to undo it for a retry."""
         return (self.parcels.copy(), copy.deepcopy(self.injector), self.injected, self.outflow, self.grid,
-                self.leakoff)
+                self.leakoff, self.screen_out_time)
 
     def _restore(self, saved: tuple) -> None:
-        parcels, injector, self.injected, self.outflow, self.grid, self.leakoff = saved
+        parcels, injector, self.injected, self.outflow, self.grid, self.leakoff, self.screen_out_time = saved
         self.parcels, self.injector = parcels.copy(), copy.deepcopy(injector)
         self.solver.set_grid(self.grid)
 
@@ -317,7 +342,8 @@ class ProppantSimulation:
 
     def balance(self) -> SolidBalanceRecord:
         return SolidBalanceRecord(time=self.time, injected=self.injected,
-                                  in_domain=float(np.sum(self.parcels.solid_volume())), outflow=self.outflow)
+                                  in_domain=float(np.sum(self.parcels.solid_volume())), outflow=self.outflow,
+                                  screened_out=self.screened_out)
 
     def run(self, sink, progress: Callable[[float], None] | None = None,
             on_step: Callable[[StepInfo], None] | None = None) -> dict:
@@ -348,8 +374,19 @@ class ProppantSimulation:
             sink.proppant_snapshot(self.snapshot())
         record = self.balance()
         return dict(time=self.time, steps=self.steps, parcels=self.parcels.n, injected=record.injected,
-                    in_domain=record.in_domain, outflow=record.outflow,
+                    in_domain=record.in_domain, outflow=record.outflow, screened_out=record.screened_out,
+                    screen_out_time=self.screen_out_time,
                     max_continuity_residual=max_residual, backend=self.numerics.backend)
+
+
+def warn_screen_out(summary: dict, theta_cp: float, offset: float = 0.0) -> None:
+    """A RuntimeWarning line when a run's inlets held proppant back (``summary`` of :meth:`ProppantSimulation.run`;
+    ``offset`` moves its times onto the caller's clock)."""
+    if summary["screened_out"] > 0.0:
+        warnings.warn(f"screen-out: the inlets held back {summary['screened_out']:.4g} m^3 of proppant "
+                      f"({100 * summary['screened_out'] / summary['injected']:.1f} % of the injected solids), "
+                      f"first at t = {summary['screen_out_time'] + offset:g} s: their cells were packed to "
+                      f"theta_cp = {theta_cp:g}", RuntimeWarning, stacklevel=3)
 
 
 def simulate(scene, sink, progress: Callable[[float], None] | None = None,
@@ -359,6 +396,9 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None,
     ``sink`` receives ``proppant_snapshot`` and ``proppant_balance`` records (hfgpu.records); ``progress(t)``
     is called after every fluid step; ``width_field(t) -> (width, leakoff)`` optionally drives the width and
     leak-off fields (nz, nx) of the grid in time (coupling to a growing fracture). Returns a summary dict
-    (time, steps, parcels, injected, in_domain, outflow, max_continuity_residual, backend).
+    (time, steps, parcels, injected, in_domain, outflow, screened_out, screen_out_time (NaN when none),
+    max_continuity_residual, backend).
     """
-    return ProppantSimulation(scene, width_field=width_field).run(sink, progress)
+    summary = ProppantSimulation(scene, width_field=width_field).run(sink, progress)
+    warn_screen_out(summary, scene.proppant.params.theta_cp)
+    return summary

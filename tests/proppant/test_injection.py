@@ -78,3 +78,60 @@ def test_initial_suspension_is_uniform_and_exact():
     per_cell = np.zeros_like(width)
     np.add.at(per_cell, (k, i), batch["particles"] * 4 / 3 * np.pi * batch["radius"] ** 3)
     np.testing.assert_allclose(per_cell, 0.02 * volume, rtol=1e-12, atol=1e-20)
+
+
+def _screen_run(width, room, steps=100):
+    """An inlet at cell (10, 20) emitting 6.6 % slurry into cells with the given room; returns
+    (injector, placed batches, scheduled solid volume, room left)."""
+    inj = Injector((Port("point", x=0.205, depth=0.105),), FRAME, width, (SAND,), [20.0],
+                   rate=lambda t0, t1: 3.79e-4, loadings=lambda t: [(0, 0.065845)], rng=np.random.default_rng(7))
+    room = room.copy()
+    batches, t = [], 0.0
+    for _ in range(steps):
+        batches.append(inj.emit(t, t + 1e-3, room=room, width=width))
+        t += 1e-3
+    return inj, batches, 0.065845 * 3.79e-4 * t, room
+
+
+def test_inlet_in_packed_cells_holds_everything_back_with_the_balance_exact():
+    inj, batches, scheduled, _ = _screen_run(WIDTH, np.zeros_like(WIDTH))
+    assert sum(b["x"].size for b in batches) == 0
+    assert inj.screened_out + inj.owed_volume() == pytest.approx(scheduled, rel=1e-12)
+    assert inj.screened_out > 0.9 * scheduled
+
+
+def test_inlet_walled_in_by_closed_cells_fills_its_room_then_screens_out():
+    width = np.zeros_like(WIDTH)
+    width[10, 20] = 5e-3  # a single open cell: every parcel's bilinear weight lies on it
+    capacity = 0.3 * 0.065845 * 3.79e-4 * 0.1  # room for 30 % of the scheduled solids
+    room = np.zeros_like(width)
+    room[10, 20] = capacity
+    inj, batches, scheduled, left = _screen_run(width, room)
+    placed = sum(batch_solid_volume(b) for b in batches)
+    parcel = 20 * np.pi / 6 * 6e-4**3  # largest parcel of the 300-600 um class
+    assert capacity - parcel < placed <= capacity * (1 + 1e-12)
+    assert left[10, 20] == pytest.approx(capacity - placed, rel=1e-9, abs=1e-18)
+    assert placed + inj.screened_out + inj.owed_volume() == pytest.approx(scheduled, rel=1e-12)
+    # nothing held back while the room lasted: the emitted parcels are the first ones scheduled
+    assert inj.screened_out == pytest.approx(scheduled - placed - inj.owed_volume(), rel=1e-12)
+
+
+def test_room_never_overfilled_through_bilinear_spill():
+    room = np.full_like(WIDTH, 1e-12)  # neighbours nearly packed
+    room[10, 20] = 1e-5
+    inj, batches, scheduled, left = _screen_run(WIDTH, room, steps=20)
+    assert np.all(left >= -1e-24)
+    assert sum(batch_solid_volume(b) for b in batches) + inj.screened_out + inj.owed_volume() \
+        == pytest.approx(scheduled, rel=1e-12)
+
+
+def test_a_zero_length_step_is_a_clear_error():
+    from pathlib import Path
+
+    from hfgpu import SimulationError, load_scene
+    from hfgpu.proppant.simulator import ProppantSimulation
+
+    scene = load_scene(Path(__file__).resolve().parents[2] / "hfgpu" / "scenes" / "settling_stokes.toml")
+    sim = ProppantSimulation(scene)
+    with pytest.raises(SimulationError, match="zero-length time step"):
+        sim.step(limit=0.0)
