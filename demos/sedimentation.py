@@ -19,21 +19,10 @@ from hfgpu import load_scene  # noqa: E402
 from hfgpu.proppant.analysis import class_volume_fraction, interface_depth, row_profile  # noqa: E402
 from hfgpu.proppant.simulator import ProppantSimulation  # noqa: E402
 from hfgpu.reference.settling import bidisperse_batch, bidisperse_interface_heights  # noqa: E402
+from hfgpu.records import MemorySink  # noqa: E402
 
 SCENE = Path(__file__).resolve().parents[1] / "hfgpu" / "scenes" / "davis1982.toml"
 
-
-class Snapshots:
-    """A sink keeping the proppant snapshots in memory."""
-
-    def __init__(self):
-        self.items = []
-
-    def proppant_snapshot(self, record):
-        self.items.append(record)
-
-    def proppant_balance(self, record):
-        pass
 
 
 def main() -> None:
@@ -61,7 +50,7 @@ def main() -> None:
                         height - interface_depth(row_profile(tl, width), frame, 0.5 * theory.phi_light_only),
                         height - interface_depth(row_profile(th, width), frame, 0.5 * heavy.initial_volume_fraction)))
 
-    sink = Snapshots()
+    sink = MemorySink()
     summary = sim.run(sink, on_step=record)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -84,7 +73,7 @@ def main() -> None:
     fig.tight_layout()
     fig.savefig(out / "davis_interfaces.png", dpi=150)
 
-    snap = min(sink.items, key=lambda s: abs(s.time - 300.0))
+    snap = min(sink.proppant_snapshots, key=lambda s: abs(s.time - 300.0))
     p = snap.parcels
     fig, axes = plt.subplots(1, 3, figsize=(9, 5), sharey=True)
     for ax, values, label in zip(axes, (p["density"], 1e6 * p["radius"], 100 * np.hypot(p["u"], p["v"])),

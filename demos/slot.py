@@ -19,21 +19,12 @@ import numpy as np  # noqa: E402
 from hfgpu import load_scene  # noqa: E402
 from hfgpu.proppant.analysis import bank, bed_height  # noqa: E402
 from hfgpu.proppant.simulator import ProppantSimulation  # noqa: E402
+from hfgpu.records import MemorySink  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "hfgpu" / "scenes" / "chun2020_slot.toml"
 DATA = ROOT.parent / "shared" / "validation-data" / "chun_2020_bank_length_area_geos.txt"
 
-
-class Snapshots:
-    def __init__(self):
-        self.items = []
-
-    def proppant_snapshot(self, record):
-        self.items.append(record)
-
-    def proppant_balance(self, record):
-        pass
 
 
 def main() -> None:
@@ -47,14 +38,14 @@ def main() -> None:
     if args.end is not None:
         scene = scene.replace(run=type(scene.run)(args.end, scene.run.physics, scene.run.seed))
     sim = ProppantSimulation(scene)
-    sink = Snapshots()
+    sink = MemorySink()
     summary = sim.run(sink, progress=lambda t: None)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     threshold = 0.5 * sim.params.theta_cp
     g = scene.proppant.geometry
 
-    shown = [s for s in sink.items if any(abs(s.time - t) < 1e-6 for t in (5.0, 15.0, 20.0, 30.0))]
+    shown = [s for s in sink.proppant_snapshots if any(abs(s.time - t) < 1e-6 for t in (5.0, 15.0, 20.0, 30.0))]
     fig, axes = plt.subplots(len(shown), 1, figsize=(8, 2.2 * len(shown)), squeeze=False)
     for ax, snap in zip(axes[:, 0], shown):
         im = ax.imshow(snap.grid["volume_fraction"], extent=(0, g.length, g.height, 0), vmin=0,
@@ -78,8 +69,8 @@ def main() -> None:
     fig.tight_layout()
     fig.savefig(out / "slot_bed_profiles.png", dpi=150)
 
-    t = np.array([s.time for s in sink.items])
-    banks = [bank(s.grid["volume_fraction"], s.grid["width"], s.frame, threshold) for s in sink.items]
+    t = np.array([s.time for s in sink.proppant_snapshots])
+    banks = [bank(s.grid["volume_fraction"], s.grid["width"], s.frame, threshold) for s in sink.proppant_snapshots]
     fig, ax = plt.subplots(figsize=(5, 3.5))
     ax.plot(t, [b.normalised_length for b in banks], "b-o", ms=3, label="bank length (MP-PIC)")
     ax.plot(t, [b.normalised_area for b in banks], "r-o", ms=3, label="bank area (MP-PIC)")
@@ -92,7 +83,7 @@ def main() -> None:
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(out / "slot_bank.png", dpi=150)
-    for s, b in zip(sink.items, banks):
+    for s, b in zip(sink.proppant_snapshots, banks):
         print(f"t = {s.time:5.1f} s  bank length {b.normalised_length:.3f}  area {b.normalised_area:.3f}")
     print(f"{summary['steps']} steps, {summary['parcels']} parcels, outflow {summary['outflow']:.3e} m^3; "
           f"figures in {out}/")

@@ -88,3 +88,25 @@ class SolidBalanceRecord:
     in_domain: float
     outflow: float
     screened_out: float = 0.0
+
+
+class MemorySink:
+    """A sink that keeps every record in lists (for scripts, demos and tests that post-process in memory)."""
+
+    def __init__(self):
+        self.fracture_snapshots: list[FractureSnapshot] = []
+        self.fracture_balances: list[BalanceRecord] = []
+        self.proppant_snapshots: list[ProppantSnapshot] = []
+        self.proppant_balances: list[SolidBalanceRecord] = []
+
+    def fracture_snapshot(self, record: FractureSnapshot) -> None:
+        self.fracture_snapshots.append(record)
+
+    def fracture_balance(self, record: BalanceRecord) -> None:
+        self.fracture_balances.append(record)
+
+    def proppant_snapshot(self, record: ProppantSnapshot) -> None:
+        self.proppant_snapshots.append(record)
+
+    def proppant_balance(self, record: SolidBalanceRecord) -> None:
+        self.proppant_balances.append(record)
