@@ -82,10 +82,7 @@ def top_interface_speed(text: str, t_fit: tuple[float, float]) -> tuple[float, f
 
 @pytest.mark.parametrize("phi", [0.1, pytest.param(0.05, marks=pytest.mark.slow),
                                  pytest.param(0.2, marks=pytest.mark.slow),
-                                 pytest.param(0.3, marks=[pytest.mark.slow, pytest.mark.xfail(
-                                     reason="the bed reaching close packing at the bottom turns unstable "
-                                     "(particle stress / packing limiter) before the fit window ends",
-                                     strict=False)])])
+                                 pytest.param(0.3, marks=pytest.mark.slow)])
 def test_hindered_settling_richardson_zaki(phi):
     text = scene_text("settling_hindered.toml").replace("initial_volume_fraction = 0.1",
                                                         f"initial_volume_fraction = {phi}")
