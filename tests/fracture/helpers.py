@@ -1,4 +1,4 @@
-"""Shared helpers of the fracture-engine tests: a list-collecting sink and scene builders."""
+"""Shared helpers of the fracture-engine tests: scene builders (records go to hfgpu.records.MemorySink)."""
 
 from __future__ import annotations
 
@@ -7,20 +7,6 @@ from pathlib import Path
 from hfgpu.scene import load_scene
 
 SCENES = Path(__file__).resolve().parents[2] / "hfgpu" / "scenes"
-
-
-class ListSink:
-    """Collects what the simulator hands to an output sink."""
-
-    def __init__(self):
-        self.balances = []
-        self.snapshots = []
-
-    def fracture_balance(self, record):
-        self.balances.append(record)
-
-    def fracture_snapshot(self, snapshot):
-        self.snapshots.append(snapshot)
 
 
 def scene_text(end_time="100 s", rate="1e-3 m**3/s", cell="2 m", E="30 GPa", nu=0.25, K="0.1 MPa*m**0.5",

@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 
 from hfgpu.fracture.simulator import simulate
+from hfgpu.records import MemorySink
 from hfgpu.reference.radial import dontsov_radial
 from hfgpu.scene import load_scene
 
-from .helpers import SCENES, ListSink, scene
+from .helpers import SCENES, scene
 
 
 def _capped(sc, cap):
@@ -21,19 +22,19 @@ def _capped(sc, cap):
 
 def test_volume_balance_holds_across_coarsening_and_footprint_stays_capped():
     cap = 12
-    sink = ListSink()
+    sink = MemorySink()
     out = simulate(_capped(scene(end_time="100 s", cell="0.25 m", every="10 s"), cap), sink)
     assert out["coarsenings"] >= 2 and out["dx"] == pytest.approx(0.25 * 3 ** out["coarsenings"])
-    for rec in sink.balances:   # injected = stored + leaked at every step, merges included
+    for rec in sink.fracture_balances:   # injected = stored + leaked at every step, merges included
         assert abs(rec.injected - rec.stored - rec.leaked) <= 1e-9 * rec.injected
-    for snap in sink.snapshots:
+    for snap in sink.fracture_snapshots:
         open_ = np.isfinite(snap.opening_time)
         rows, cols = np.nonzero(open_)
         assert max(np.ptp(rows), np.ptp(cols)) + 1 <= cap + 2   # one front advance past the cap at most
         assert snap.width[open_].sum() * snap.frame.dx * snap.frame.dz == pytest.approx(
-            next(b.stored for b in sink.balances if b.time == snap.time), rel=1e-12)
+            next(b.stored for b in sink.fracture_balances if b.time == snap.time), rel=1e-12)
     # the same fracture run on a fine uncapped grid (1 m cells) ends at a radius within 10 %
-    fine = simulate(scene(end_time="100 s", cell="1 m"), ListSink())
+    fine = simulate(scene(end_time="100 s", cell="1 m"), MemorySink())
     assert out["radius"] == pytest.approx(fine["radius"], rel=0.1)
 
 
@@ -42,7 +43,7 @@ def test_long_storage_viscosity_radial_case_with_coarsening():
     """radial_long.toml: 0.1 m cells to 1e5 s (R ~ 270 m), five 3x3 merges; radius and inlet width vs
     Dontsov (2016). Measured: R +2.8 % (min/max front +1.4 / +3.9 %), w(0) -3.6 %, ~9 s; the 2.2 % goal is not met."""
     sc = load_scene(SCENES / "radial_long.toml")
-    out = simulate(sc, ListSink())
+    out = simulate(sc, MemorySink())
     rock, q, end = sc.rock, sc.injection.schedule.stages[0].rate, sc.run.end_time
     ref = dontsov_radial(rock.plane_strain_modulus, math.sqrt(32 / math.pi) * rock.toughness,
                          12 * sc.fluid.viscosity, 0.0, q, end)

@@ -11,10 +11,11 @@ import math
 import pytest
 
 from hfgpu.fracture.simulator import simulate
+from hfgpu.records import MemorySink
 from hfgpu.reference.radial import dontsov_radial, k_vertex, m_vertex
 from hfgpu.scene import Mesh, load_scene
 
-from .helpers import SCENES, ListSink
+from .helpers import SCENES
 
 
 def run_case(name: str, cell: float | None = None, **numerics):
@@ -23,7 +24,7 @@ def run_case(name: str, cell: float | None = None, **numerics):
         sc = sc.replace(mesh=Mesh(cell, cell))
     if numerics:
         sc = sc.replace(fracture=dataclasses.replace(sc.fracture, **numerics))
-    sink = ListSink()
+    sink = MemorySink()
     out = simulate(sc, sink)
     rock = sc.rock
     e_prime, mu_prime = rock.plane_strain_modulus, 12 * sc.fluid.viscosity

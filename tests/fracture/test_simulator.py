@@ -8,16 +8,17 @@ import pytest
 
 from hfgpu.errors import SceneError, SimulationError
 from hfgpu.fracture.simulator import simulate
+from hfgpu.records import MemorySink
 from hfgpu.scene import load_scene
 
-from .helpers import ListSink, scene, scene_text
+from .helpers import scene, scene_text
 
 # M-regime-ish small case: E' 3.2e10, Q 1e-3, mu 1 Pa s -> R(100 s) ~ 6 m (REFERENCE.md 1.4)
 FAST = dict(end_time="100 s", cell="1 m", every="25 s")
 
 
 def _run(sc):
-    sink = ListSink()
+    sink = MemorySink()
     times = []
     out = simulate(sc, sink, progress=times.append)
     return out, sink, times
@@ -25,13 +26,13 @@ def _run(sc):
 
 def test_sink_protocol_balance_and_progress():
     out, sink, times = _run(scene(**FAST))
-    assert len(sink.balances) == out["steps"] == len(times)
+    assert len(sink.fracture_balances) == out["steps"] == len(times)
     assert times == sorted(times) and times[-1] == pytest.approx(100.0)
-    assert [s.time for s in sink.snapshots] == pytest.approx([25.0, 50.0, 75.0, 100.0])
-    for rec in sink.balances:   # injected = stored + leaked within 0.1 % at every step
+    assert [s.time for s in sink.fracture_snapshots] == pytest.approx([25.0, 50.0, 75.0, 100.0])
+    for rec in sink.fracture_balances:   # injected = stored + leaked within 0.1 % at every step
         assert abs(rec.injected - rec.stored - rec.leaked) <= 1e-3 * rec.injected
         assert rec.injected == pytest.approx(1e-3 * rec.time, rel=1e-12)
-    snap = sink.snapshots[-1]
+    snap = sink.fracture_snapshots[-1]
     nz, nx = snap.width.shape
     for a in (snap.pressure, snap.leakoff_rate, snap.opening_time):
         assert a.shape == (nz, nx)
@@ -49,7 +50,7 @@ def test_sink_protocol_balance_and_progress():
 def test_front_never_retreats_and_opening_times_are_kept():
     _, sink, _ = _run(scene(**FAST))
     previous = None
-    for snap in sink.snapshots:
+    for snap in sink.fracture_snapshots:
         x, z = snap.frame.centres(*snap.width.shape)
         cells = {(round(xx), round(zz)): t for (zz, xx), t in
                  zip(np.array(np.meshgrid(z, x, indexing="ij")).reshape(2, -1).T, snap.opening_time.ravel())
@@ -63,13 +64,13 @@ def test_front_never_retreats_and_opening_times_are_kept():
 def test_shut_in_keeps_the_injected_volume_and_the_balance():
     sched = '[{ until = "60 s", rate = "1e-3 m**3/s" }, { until = "100 s", rate = "0 m**3/s" }]'
     out, sink, _ = _run(scene(end_time="100 s", cell="1 m", CL="1e-5 m/s**0.5", schedule=sched, every="20 s"))
-    assert any(abs(b.time - 60.0) < 1e-9 for b in sink.balances)          # a step lands on the breakpoint
-    after = [b for b in sink.balances if b.time > 60.0]
+    assert any(abs(b.time - 60.0) < 1e-9 for b in sink.fracture_balances)          # a step lands on the breakpoint
+    after = [b for b in sink.fracture_balances if b.time > 60.0]
     assert after and all(b.injected == pytest.approx(0.06, rel=1e-12) for b in after)
     assert after[-1].leaked > after[0].leaked and after[-1].stored < after[0].stored   # leak-off drains it
-    for rec in sink.balances:
+    for rec in sink.fracture_balances:
         assert abs(rec.injected - rec.stored - rec.leaked) <= 1e-3 * rec.injected
-    assert out["cells"] >= max(np.isfinite(s.opening_time).sum() for s in sink.snapshots)
+    assert out["cells"] >= max(np.isfinite(s.opening_time).sum() for s in sink.fracture_snapshots)
 
 
 def test_fracture_grows_towards_lower_stress():
@@ -96,7 +97,7 @@ min_stress = "8 MPa"
 def test_bad_input_is_rejected_before_work_starts():
     with pytest.raises(SceneError, match=r"injection.schedule\[0\].rate"):
         simulate(scene(schedule='[{ until = "10 s", rate = "0 m**3/s" }, { until = "100 s", rate = "1e-3 m**3/s" }]'),
-                 ListSink())
+                 MemorySink())
     with pytest.raises(SceneError, match="fracture.tip_asymptote"):
         load_scene(scene_text(fracture='[fracture]\ntip_asymptote = "magic"'))
     with pytest.raises(SceneError, match="fracture.tip_velocity"):
@@ -104,14 +105,14 @@ def test_bad_input_is_rejected_before_work_starts():
     with pytest.raises(SceneError, match="fracture.partial_tip_cells"):
         load_scene(scene_text(fracture='[fracture]\npartial_tip_cells = 3'))
     with pytest.raises(SceneError, match="fracture.initial_radius_cells"):
-        simulate(scene(end_time="0.001 s", cell="1 m"), ListSink())
+        simulate(scene(end_time="0.001 s", cell="1 m"), MemorySink())
 
 
 def test_newton_failure_raises_simulation_error_with_time_cell_and_residual():
     sc = scene(**FAST, fracture="[fracture]\nnewton_max_iterations = 1\nmax_step_retries = 1\n"
                                 "newton_tolerance = 1e-12")
     with pytest.raises(SimulationError) as info:
-        simulate(sc, ListSink())
+        simulate(sc, MemorySink())
     err = info.value
     assert err.time is not None and err.cell is not None and err.residual is not None
     assert "Newton" in str(err)
@@ -120,6 +121,6 @@ def test_newton_failure_raises_simulation_error_with_time_cell_and_residual():
 def test_direct_and_krylov_runs_agree():
     base = scene(end_time="30 s", cell="1 m")
     krylov = base.replace(fracture=dataclasses.replace(base.fracture, linear_solver="krylov"))
-    a, b = simulate(base, ListSink()), simulate(krylov, ListSink())
+    a, b = simulate(base, MemorySink()), simulate(krylov, MemorySink())
     assert a["cells"] == b["cells"]
     assert b["w_inlet"] == pytest.approx(a["w_inlet"], rel=1e-4)

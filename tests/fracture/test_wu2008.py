@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 
 from hfgpu.fracture.simulator import simulate
+from hfgpu.records import MemorySink
 from hfgpu.scene import load_scene
 
-from .helpers import SCENES, ListSink
+from .helpers import SCENES
 
 TIMES = (665.0, 376.0, 144.0, 60.0, 22.0)   # column pairs of the csv, in this order
 
@@ -25,9 +26,9 @@ def measured_extents(shared_dir):
 
 
 def simulated_extents():
-    sink = ListSink()
+    sink = MemorySink()
     simulate(load_scene(SCENES / "wu2008.toml"), sink)
-    snaps = {round(s.time): s.extras for s in sink.snapshots}
+    snaps = {round(s.time): s.extras for s in sink.fracture_snapshots}
     return {t: tuple(float(snaps[round(t)][f"front_{k}"]) for k in ("up", "down", "left", "right"))
             for t in TIMES}
 
