@@ -9,6 +9,7 @@ proppant added per US gallon of clean fluid.
 from __future__ import annotations
 
 import functools
+import re
 import warnings
 
 import pint
@@ -75,6 +76,7 @@ def to_si(value: object, kind: str, path: str = "value") -> float:
     if isinstance(value, (int, float)):
         number = float(value)
     elif isinstance(value, str):
+        _check_quantity_text(value, path, allowed)
         ureg = registry()
         try:
             quantity = ureg.Quantity(value.strip())
@@ -92,6 +94,17 @@ def to_si(value: object, kind: str, path: str = "value") -> float:
     if number != number or number in (float("inf"), float("-inf")):
         raise SceneError(path, value, f"{allowed}; the value must be finite")
     return number
+
+
+_LEADING_NUMBER = re.compile(r"\s*[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+def _check_quantity_text(value: str, path: str, allowed: str) -> None:
+    """One number, then units: pint would read "0 3 m" (or "0\\n3 m") as 0 * 3 m, and "MPa" as 1 MPa."""
+    match = _LEADING_NUMBER.match(value)
+    rest = value[match.end():].lstrip(" ") if match else ""
+    if match is None or any(c in value for c in "\r\n\t\f\v") or rest[:1].isdigit() or rest[:1] == ".":
+        raise SceneError(path, value, f"{allowed}; write one number followed by its units")
 
 
 def convert(value: float, from_unit: str, to_unit: str) -> float:
