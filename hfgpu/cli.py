@@ -21,6 +21,8 @@ def _parser() -> argparse.ArgumentParser:
     run = commands.add_parser("run", help="run a scene and write a results file")
     run.add_argument("scene", type=Path, help="scene file (TOML)")
     run.add_argument("--out", type=Path, required=True, help="results file to write (HDF5, replaced)")
+    run.add_argument("--resume", action="store_true", help="continue the killed run in --out from its last "
+                     "checkpoint (the scene must be the same); a complete file is left alone")
     run.add_argument("--rrd", type=Path, help="also save a Rerun recording to this .rrd file")
     run.add_argument("--view", action="store_true", help="stream to a Rerun viewer (spawned)")
     run.add_argument("--no-progress", action="store_true", help="no progress bar and no summary table")
@@ -37,7 +39,7 @@ def _parser() -> argparse.ArgumentParser:
 def _run(args: argparse.Namespace) -> None:
     from .runner import run
 
-    run(args.scene, args.out, progress=not args.no_progress, rrd=args.rrd, view=args.view)
+    run(args.scene, args.out, progress=not args.no_progress, rrd=args.rrd, view=args.view, resume=args.resume)
 
 
 def _plot(args: argparse.Namespace) -> None:
@@ -49,6 +51,7 @@ def _plot(args: argparse.Namespace) -> None:
 
 
 def _check(args: argparse.Namespace) -> None:
+    from .presets import knob_report
     from .runner import check_supported
     from .scene import load_scene
 
@@ -56,6 +59,7 @@ def _check(args: argparse.Namespace) -> None:
     check_supported(scene)
     print(f"{args.scene}: ok; physics {', '.join(scene.run.physics)}, end time {scene.run.end_time:g} s, "
           f"cells {scene.mesh.dx:g} x {scene.mesh.dz:g} m, output every {scene.output.every:g} s")
+    print(knob_report(scene))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -63,8 +67,8 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         {"run": _run, "plot": _plot, "check": _check}[args.command](args)
-    except HfgpuError as exc:
-        print(f"hfgpu {args.command}: error: {exc}", file=sys.stderr)
+    except HfgpuError as exc:  # one line, even where a scene value holds line breaks
+        print(f"hfgpu {args.command}: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"hfgpu {args.command}: interrupted", file=sys.stderr)

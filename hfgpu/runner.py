@@ -3,18 +3,24 @@
 Only what the scene requires is imported: physics ["fracture"] loads ``hfgpu.fracture.simulator`` and
 no proppant code, ["proppant"] loads ``hfgpu.proppant.simulator`` and no fracture code; both at once run the
 one-way coupled model of ``hfgpu.coupled`` (fracture first, proppant on its history).
+
+Checkpoints: the simulator gets a :class:`hfgpu.io.checkpoint.Checkpointer` writing into the results file;
+``resume=True`` continues a killed (or failed) run from the checkpoint in its results file.
 """
 
 from __future__ import annotations
 
 import importlib
+import math
 from pathlib import Path
 from typing import Any, Callable
 
 from .errors import HfgpuError
+from .limits import check_limits
 from .scene import Scene, load_scene
 
-#: The module whose ``simulate(scene, sink, progress=None) -> dict`` runs each physics set.
+#: The module whose ``simulate(scene, sink, progress=None, checkpoint=None, resume=None) -> dict`` runs each
+#: physics set.
 SIMULATORS = {("fracture",): "hfgpu.fracture.simulator", ("proppant",): "hfgpu.proppant.simulator",
               ("fracture", "proppant"): "hfgpu.coupled"}
 
@@ -57,19 +63,35 @@ def simulator_for(scene: Scene) -> Callable[..., dict]:
 
 
 def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = True,
-        rrd: str | Path | None = None, view: bool = False) -> dict[str, Any]:
+        rrd: str | Path | None = None, view: bool = False, resume: bool = False) -> dict[str, Any]:
     """Run a scene and write the results file ``out``; return the run's summary.
 
     ``progress`` shows a bar over simulated time and prints the summary table; ``rrd`` saves a Rerun
     recording to that file; ``view`` streams to a spawned Rerun viewer. On any error the results file
     is closed with status "failed: <message>" (every completed snapshot kept) and the error re-raised.
+    Checkpoints go into ``out`` every :func:`hfgpu.io.checkpoint.checkpoint_interval` of simulated time.
+
+    ``resume``: continue the run in ``out`` from its last checkpoint (the scene must equal the one stored
+    there, else :class:`HfgpuError` naming what differs; a file without a checkpoint is an error too); the
+    file then ends as an uninterrupted run's would. A file whose run is complete is left alone: a line says
+    so and its stored summary is returned. The Rerun recording of a resumed run holds the resumed part only.
     """
     scene = scene_or_path if isinstance(scene_or_path, Scene) else load_scene(scene_or_path)
+    check_limits(scene)
     simulate = simulator_for(scene)
+    from .io.checkpoint import Checkpointer, checkpoint_interval
     from .io.progress import Progress, summary_table
     from .io.results import ResultsWriter
 
-    writer = ResultsWriter(out, scene)
+    state = kept = None
+    if resume:
+        opened = _reopen(scene, Path(out))
+        if isinstance(opened, dict):
+            return opened
+        writer, start, state, kept = opened
+    else:
+        writer, start = ResultsWriter(out, scene), 0.0
+    checkpoint = Checkpointer(writer.write_checkpoint, checkpoint_interval(scene), start)
     sinks: list[Any] = [writer]
     try:
         if rrd is not None or view:
@@ -80,20 +102,61 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
         writer.fail(str(exc) or type(exc).__name__)
         raise
     bar = Progress(scene.run.end_time, enabled=progress)
+    if kept is not None:
+        _carry_over(bar, kept)
     sinks.append(bar)
     try:
-        result = simulate(scene, FanOut(sinks), progress=bar)
+        result = simulate(scene, FanOut(sinks), progress=bar, checkpoint=checkpoint, resume=state)
     except BaseException as exc:
         _close_others(sinks[1:])
         message = str(exc) or type(exc).__name__
         writer.fail(message, {**bar.stats(), "error_type": type(exc).__name__})
         raise
     _close_others(sinks[1:])
-    summary = {**(result or {}), **bar.stats(), "status": "complete", "out": str(out)}
+    summary = {**(result or {}), **bar.stats(), "status": "complete", "out": str(out),
+               "checkpoints": checkpoint.written, "resumed_from": start if resume else math.nan}
     writer.close("complete", summary)
     if progress:
         print(summary_table(summary), flush=True)
     return summary
+
+
+def _reopen(scene: Scene, out: Path):
+    """``out`` reopened at its checkpoint: (writer, checkpoint time, state, the file's Results as kept), the state
+    of a coupled run with the file's fracture snapshots added; or the stored summary of a complete run."""
+    from .io.checkpoint import scene_differences
+    from .io.results import ResultsWriter, open_results
+
+    results = open_results(out)
+    if not results.scene_text:
+        raise HfgpuError(f"cannot resume '{out}': it stores no scene text to check the scene against")
+    differences = scene_differences(results.scene, scene)
+    if differences:
+        raise HfgpuError(f"cannot resume '{out}': the scene differs from the one it was run with: "
+                         + "; ".join(differences))
+    if results.status == "complete":
+        print(f"{out}: the run is already complete; nothing to resume", flush=True)
+        return results.summary
+    writer, time, state = ResultsWriter.reopen(out)
+    kept = open_results(out)
+    if len(scene.run.physics) > 1:
+        state["fracture_snapshots"] = kept.fracture_snapshots[:]
+    return writer, time, state, kept
+
+
+def _carry_over(bar: Any, kept: Any) -> None:
+    """Give the progress bar of a resumed run the counts and last balance rows of the records the file kept
+    (``kept``: its Results), so that the summary counts the whole run."""
+    from .records import BalanceRecord, SolidBalanceRecord
+
+    for physics, record in (("fracture", BalanceRecord), ("proppant", SolidBalanceRecord)):
+        rows = getattr(kept, f"{physics}_balance")
+        steps = rows["time"].size if rows else 0
+        bar.counts[f"{physics}_snapshots"] = len(getattr(kept, f"{physics}_snapshots"))
+        bar.counts[f"{physics}_steps"] = steps
+        if steps:
+            setattr(bar, physics, record(**{name: float(column[-1]) for name, column in rows.items()}))
+    bar(kept.checkpoint_time)
 
 
 def _close_others(sinks: list[Any]) -> None:

@@ -28,6 +28,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from .errors import SceneError
+from .presets import DEFAULT_PRESET, PRESETS, Preset
 from .scene_reader import Table
 
 PHYSICS = ("fracture", "proppant")
@@ -35,9 +36,13 @@ PHYSICS = ("fracture", "proppant")
 
 @dataclass(frozen=True)
 class RunConfig:
+    """``[run]``; ``preset`` names the entry of :data:`hfgpu.presets.PRESETS` that gave the numerical
+    knobs' defaults."""
+
     end_time: float
     physics: tuple[str, ...]
     seed: int = 0
+    preset: str = DEFAULT_PRESET
 
 
 @dataclass(frozen=True)
@@ -172,12 +177,21 @@ class Injection:
 
 @dataclass(frozen=True)
 class Mesh:
-    """Cell sizes [m]; ``max_cells_across`` caps the footprint's cells along x or z (the fracture grid
-    is coarsened 3x3 beyond it, see docs/scene.md), None for no cap."""
+    """The cell sizes in use [m]: ``dx``, ``dz`` = the scene's ``[mesh] cell_size`` / ``refinement``.
+
+    ``max_cells_across`` (in use, i.e. the scene's value x refinement, at least 8) caps the footprint's cells
+    along x or z (the fracture grid is coarsened 3x3 beyond it, see docs/scene.md), None for no cap.
+    """
 
     dx: float
     dz: float
     max_cells_across: int | None = None
+    refinement: float = 1.0
+
+    @property
+    def scene_cell_size(self) -> tuple[float, float]:
+        """The scene's ``[mesh] cell_size`` (dx, dz) [m]: the cells at refinement 1."""
+        return self.dx * self.refinement, self.dz * self.refinement
 
 
 @dataclass(frozen=True)
@@ -242,8 +256,9 @@ def parse_scene(data: dict, source: str = "") -> Scene:
     """Validate a parsed TOML document into a :class:`Scene`."""
     top = Table(data, "")
     run = _parse_run(top.table("run"))
+    preset = PRESETS[run.preset]
     fluid = _parse_fluid(top.table("fluid"))
-    mesh = _parse_mesh(top.table("mesh"))
+    mesh = _parse_mesh(top.table("mesh"), preset)
     output = _parse_output(top.table("output"), run.end_time)
 
     rock = injection = fracture = proppant = None
@@ -255,7 +270,7 @@ def parse_scene(data: dict, source: str = "") -> Scene:
     if "fracture" in run.physics:
         from .fracture.config import parse_fracture_numerics
 
-        fracture = parse_fracture_numerics(top.table("fracture", {}))
+        fracture = parse_fracture_numerics(top.table("fracture", {}), preset)
     if "proppant" in run.physics:
         from .proppant.config import parse_proppant_setup
 
@@ -272,7 +287,7 @@ def parse_scene(data: dict, source: str = "") -> Scene:
     if len(run.physics) > 1:
         from .coupled import parse_coupling
 
-        coupling = parse_coupling(top.table("coupling", {}), run.end_time)
+        coupling = parse_coupling(top.table("coupling", {}), run.end_time, mesh.refinement)
     elif top.has("coupling"):
         top.raw("coupling")
         raise SceneError("coupling", "(table)", 'this section needs both "fracture" and "proppant" in run.physics')
@@ -286,13 +301,15 @@ def _parse_run(t: Table) -> RunConfig:
     physics = t.raw("physics", ["fracture"])
     if isinstance(physics, str):
         physics = [physics]
-    if (not isinstance(physics, list) or not physics or len(set(physics)) != len(physics)
-            or any(p not in PHYSICS for p in physics)):
+    if (not isinstance(physics, list) or not physics or any(p not in PHYSICS for p in physics)
+            or len(set(physics)) != len(physics)):
         raise SceneError(t.key_path("physics"), physics,
                          f"expected a non-empty list of distinct names from {list(PHYSICS)}")
     seed = t.integer("seed", 0, minimum=0)
+    preset = t.choice("preset", PRESETS, DEFAULT_PRESET)
     t.finish()
-    return RunConfig(end_time=end_time, physics=tuple(p for p in PHYSICS if p in physics), seed=seed)
+    return RunConfig(end_time=end_time, physics=tuple(p for p in PHYSICS if p in physics), seed=seed,
+                     preset=preset)
 
 
 def _parse_fluid(t: Table) -> Fluid:
@@ -304,7 +321,8 @@ def _parse_fluid(t: Table) -> Fluid:
     return fluid
 
 
-def _parse_mesh(t: Table) -> Mesh:
+def _parse_mesh(t: Table, preset: Preset) -> Mesh:
+    """``[mesh]``: cells in use = cell_size / refinement (default the preset's), cap x refinement (>= 8)."""
     size = t.raw("cell_size")
     path = t.key_path("cell_size")
     if isinstance(size, list):
@@ -314,16 +332,21 @@ def _parse_mesh(t: Table) -> Mesh:
                                                           exclusive_minimum=True) for s in size]
     else:
         sizes = [t.quantity("cell_size", "length", minimum=0.0, exclusive_minimum=True)] * 2
+    refinement = t.number("refinement", preset.refinement, minimum=0.01, maximum=100.0)
     cap = t.raw("max_cells_across", None)
     if cap is not None:
-        cap = t.integer("max_cells_across", minimum=8)
+        cap = max(8, round(t.integer("max_cells_across", minimum=8) * refinement))
     t.finish()
-    return Mesh(dx=sizes[0], dz=sizes[1], max_cells_across=cap)
+    return Mesh(dx=sizes[0] / refinement, dz=sizes[1] / refinement, max_cells_across=cap,
+                refinement=refinement)
 
 
 def _parse_output(t: Table, end_time: float) -> Output:
+    """``[output]``: ``checkpoint_every`` is None when absent (the default rule of hfgpu.io.checkpoint), 0 for
+    "0 s" or false (no checkpoints)."""
     every = t.quantity("every", "time", end_time / 10.0, minimum=0.0, exclusive_minimum=True)
-    checkpoint = t.quantity("checkpoint_every", "time", None, minimum=0.0, exclusive_minimum=True)
+    off = t.raw("checkpoint_every", None) is False
+    checkpoint = 0.0 if off else t.quantity("checkpoint_every", "time", None, minimum=0.0)
     t.finish()
     return Output(every=every, checkpoint_every=checkpoint)
 
@@ -382,7 +405,7 @@ def _parse_injection(t: Table, proppant_densities: dict[str, float]) -> Injectio
             raise SceneError(st.key_path("until"), item.get("until"), f"stages must end in increasing "
                              f"time; this one must end after {start:g} s")
         rate = st.quantity("rate", "rate", minimum=0.0)
-        name = st.raw("proppant", None)
+        name = st.string("proppant") if st.has("proppant") else None
         fraction = end_fraction = 0.0
         if name is not None:
             if name not in proppant_densities:

@@ -41,8 +41,8 @@ WITH_FAKE = textwrap.dedent("""
     from hfgpu.cli import main
     fail_at = None if sys.argv[1] == "none" else int(sys.argv[1])
     module = types.ModuleType("hfgpu.fracture.simulator")
-    module.simulate = lambda scene, sink, progress=None: fakes.simulate_fracture(scene, sink, progress,
-                                                                                 fail_at=fail_at)
+    module.simulate = lambda scene, sink, progress=None, **checkpoints: fakes.simulate_fracture(
+        scene, sink, progress, fail_at=fail_at)
     sys.modules[module.__name__] = module
     sys.exit(main(sys.argv[2:]))
 """)

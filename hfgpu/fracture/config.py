@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..presets import BALANCED, Preset
 from ..scene_reader import Table
 
 
@@ -26,10 +27,12 @@ class FractureNumerics:
         "front" (at least the mean front speed through the tip element, Eq. 34), see front.tip_velocity.
     partial_tip_cells: spread a newly opened cell's Carter opening time over the time the front takes to
         cross it (its parent's crossing time, Eq. 34), so leak-off follows the wetted part of the cell.
+    max_front_advance: the most the sub-grid front may move in one step, in cells; a longer step is redone
+        with half the time step, so results do not depend on how far apart output times are.
     """
 
-    time_step_relaxation: float = 0.5
-    newton_tolerance: float = 1e-6
+    time_step_relaxation: float = BALANCED.time_step_relaxation
+    newton_tolerance: float = BALANCED.newton_tolerance
     newton_max_iterations: int = 30
     linear_solver: str = "auto"
     krylov_threshold: int = 3000
@@ -40,14 +43,16 @@ class FractureNumerics:
     max_step_growth: float = 1.5
     tip_velocity: str = "front"
     partial_tip_cells: bool = True
+    max_front_advance: float = 1.0
 
 
-def parse_fracture_numerics(t: Table) -> FractureNumerics:
+def parse_fracture_numerics(t: Table, preset: Preset = BALANCED) -> FractureNumerics:
+    """``[fracture]``; the preset gives the defaults of lambda (Eq. 35) and epsilon (Eq. 32)."""
     d = FractureNumerics()
     numerics = FractureNumerics(
-        time_step_relaxation=t.number("time_step_relaxation", d.time_step_relaxation, minimum=0.0,
+        time_step_relaxation=t.number("time_step_relaxation", preset.time_step_relaxation, minimum=0.0,
                                       maximum=1.0, exclusive_minimum=True),
-        newton_tolerance=t.number("newton_tolerance", d.newton_tolerance, minimum=0.0,
+        newton_tolerance=t.number("newton_tolerance", preset.newton_tolerance, minimum=0.0,
                                   exclusive_minimum=True, maximum=0.1),
         newton_max_iterations=t.integer("newton_max_iterations", d.newton_max_iterations, minimum=1),
         linear_solver=t.choice("linear_solver", ("auto", "direct", "krylov"), d.linear_solver),
@@ -61,6 +66,7 @@ def parse_fracture_numerics(t: Table) -> FractureNumerics:
         max_step_growth=t.number("max_step_growth", d.max_step_growth, minimum=1.0, maximum=10.0),
         tip_velocity=t.choice("tip_velocity", ("fluid", "front"), d.tip_velocity),
         partial_tip_cells=t.boolean("partial_tip_cells", d.partial_tip_cells),
+        max_front_advance=t.number("max_front_advance", d.max_front_advance, minimum=0.1, maximum=10.0),
     )
     t.finish()
     return numerics

@@ -133,3 +133,15 @@ def edge_cells(active: np.ndarray) -> np.ndarray:
     return edge
 
 
+def front_distances(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndarray, k_prime: np.ndarray,
+                    reached: np.ndarray, t: float, dx: float, dz: float) -> list[np.ndarray]:
+    """Sub-grid front position: for each of DIRECTIONS, the distance s from every active cell's centre to the
+    front on that side (the inverse of ``tip_width`` at the cell's width, Eq. 33) where the neighbour on that
+    side is inactive, NaN elsewhere. V is the tip velocity of ``tip_velocity`` through the opposite face."""
+    out = []
+    for dk, di in DIRECTIONS:
+        h = dz if dk else dx
+        facing = active & ~_shift(active, -dk, -di, False)
+        v = tip_velocity(model, inflow_velocity(active, w, p, h, dk, di, model.mu_prime), h, t, reached)
+        out.append(np.where(facing, invert_tip(model, k_prime, w, v), np.nan))
+    return out

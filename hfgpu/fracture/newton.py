@@ -10,17 +10,32 @@ g the positivity ramp of :mod:`leakoff`, S the injected volume. Its analytic Jac
 
     J = diag(A (1 + dL g')) - dt L(w) C - dt D(w),   D = d(L(w) p)/dw at fixed p (conductance derivative).
 
-Each Newton update solves J dw = -F, either directly (dense LU, numpy.linalg.solve) or, for large N,
-matrix-free by GMRES (``krylov.gmres_solve``) with C applied by FFT and a SuperLU preconditioner of J with C
-cut to its near field. The update is damped by backtracking (halving the step until ||F|| decreases,
-at most LINE_SEARCH_HALVINGS times): the conductance's kink at w = 0 otherwise makes Newton cycle. Convergence is the relative update norm of Eq. 32, ||dw|| < eps ||w||.
+Each Newton update solves J dw = -F, either directly (dense LU, scipy.linalg.lu_factor) or, for large N,
+matrix-free by GMRES (``krylov.gmres_solve``) with C applied by FFT and a SuperLU preconditioner M of J with
+C cut to its near field. The update is damped by Deuflhard's natural monotonicity test (Deuflhard 2004,
+"Newton Methods for Nonlinear Problems", section 3.3, NLEQ-ERR): the step fraction lambda is halved (at most
+MONOTONICITY_HALVINGS times) until the simplified Newton correction shrinks,
+||J^-1 F(w + lambda dw)|| <= (1 - lambda/4) ||J^-1 F(w)||, with the current factorisation (M for GMRES).
+This test is affine invariant; a test on ||F|| is not, and with the cubic conductance w^3 ||F|| grows along
+good Newton directions when the step is long (large dt, leak-off dominated growth), so a residual-norm line
+search took tiny steps and exhausted the iterations. Convergence is the relative update norm of Eq. 32,
+||dw|| < eps ||w||.
+
+Contact. Widths cannot go negative (the faces would interpenetrate). After Newton converges, an open cell
+with w < 0 is closed: its width is held at 0 and its unknown becomes its fluid pressure (p = sigma + c0 x,
+c0 = C_PP, so x is in metres), which is no longer tied to the elastic relation Eq. 28 (the difference
+sigma + C w - p >= 0 is the contact traction); a closed cell whose fluid pressure exceeds sigma + C w opens
+again. Newton is rerun until the set settles (at most CONTACT_PASSES passes). Every cell keeps its mass
+balance (a closing cell drains through its faces), so the volume balance stays exact.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
+import scipy.linalg
 import scipy.sparse
 from scipy.sparse.linalg import LinearOperator
 
@@ -29,7 +44,9 @@ from .krylov import gmres_solve, splu_preconditioner
 from .leakoff import available_fraction
 from .lubrication import Faces, conductance, divergence_matrix
 
-LINE_SEARCH_HALVINGS = 8
+MONOTONICITY_HALVINGS = 10
+CONTACT_PASSES = 6
+CONTACT_TOLERANCE = 1e-7
 
 
 @dataclass(frozen=True)
@@ -60,20 +77,32 @@ class StepResult:
 
 
 class Elasticity:
-    """C of the current active set, dense (gathered once per active set) or FFT matrix-free."""
+    """C of the current active set, dense (gathered once per active set) or FFT matrix-free, and its
+    self-stiffness c0 = C_PP (the pressure scale of a closed cell's unknown)."""
 
     def __init__(self, op: ElasticityOperator, ix: np.ndarray, iz: np.ndarray, dense: bool):
         self.op, self.ix, self.iz = op, ix, iz
         self.matrix = op.dense(ix, iz) if dense else None
+        self.self_stiffness = float(op.dense(np.zeros(1, np.int64), np.zeros(1, np.int64))[0, 0])
 
     def apply(self, w: np.ndarray) -> np.ndarray:
         """C w (Eq. 20)."""
         return self.matrix @ w if self.matrix is not None else self.op.matvec(self.ix, self.iz, w)
 
 
-def residual(prob: StepProblem, elastic: Elasticity, w: np.ndarray):
-    """Eq. 29 residual F(w) with p = sigma + C w (Eq. 28), plus p, the conductances and the ramp."""
-    p = prob.sigma + elastic.apply(w)
+def _split(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray | None):
+    """(w, p) of the unknowns x: w = x, p = sigma + C w (Eq. 28) at open cells; w = 0, p = sigma + c0 x at
+    closed cells (contact: x is the fluid pressure's excess over sigma in units of c0, i.e. metres)."""
+    if closed is None or not closed.any():
+        return x, prob.sigma + elastic.apply(x)
+    w = np.where(closed, 0.0, x)
+    return w, np.where(closed, prob.sigma + elastic.self_stiffness * x, prob.sigma + elastic.apply(w))
+
+
+def residual(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray | None = None):
+    """Eq. 29 residual F(x) with the widths and pressures of ``_split``, plus p, the conductances and the
+    ramp."""
+    w, p = _split(prob, elastic, x, closed)
     t, *dt_dw = conductance(prob.faces, w, prob.w_smooth)
     lap = divergence_matrix(prob.faces, t, w.size)
     g, dg = available_fraction(w, prob.w_eps)
@@ -93,71 +122,122 @@ def _conductance_jacobian(prob: StepProblem, w: np.ndarray, p: np.ndarray,
     return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(w.size, w.size))
 
 
-def dense_jacobian(prob: StepProblem, elastic: Elasticity, w: np.ndarray) -> np.ndarray:
-    """The analytic Jacobian dF/dw of Eq. 29 (with Eq. 28 eliminated) as a dense matrix."""
-    _, p, lap, dt_dw, dg = residual(prob, elastic, w)
+def dense_jacobian(prob: StepProblem, elastic: Elasticity, x: np.ndarray,
+                   closed: np.ndarray | None = None) -> np.ndarray:
+    """The analytic Jacobian dF/dx of Eq. 29 (with Eq. 28 eliminated) as a dense matrix."""
+    closed = np.zeros(x.size, bool) if closed is None else closed
+    _, p, lap, dt_dw, dg = residual(prob, elastic, x, closed)
+    w = np.where(closed, 0.0, x)
     return _dense(prob, elastic, lap, _conductance_jacobian(prob, w, p, dt_dw),
-                  prob.area * (1.0 + prob.demand * dg))
+                  prob.area * (1.0 + prob.demand * dg), closed)
 
 
-def _dense(prob, elastic, lap, cond, diag) -> np.ndarray:
+def _dense(prob, elastic, lap, cond, diag, closed) -> np.ndarray:
+    """J = diag(A (1 + dL g')) P_o - dt L (P_o C P_o + c0 P_c) - dt D P_o, P_o / P_c the open / closed
+    selections (P_o = I without contact)."""
     c = elastic.matrix if elastic.matrix is not None else elastic.op.dense(elastic.ix, elastic.iz)
+    if closed.any():
+        c = c.copy()
+        c[closed, :] = 0.0
+        c[:, closed] = 0.0
+        k = np.flatnonzero(closed)
+        c[k, k] = elastic.self_stiffness
+    open_ = (~closed).astype(float)
     jac = -prob.dt * (lap @ c)
-    jac[np.diag_indices_from(jac)] += diag
-    jac -= prob.dt * cond.toarray()
+    jac[np.diag_indices_from(jac)] += diag * open_
+    jac -= prob.dt * (cond @ scipy.sparse.diags(open_)).toarray()
     return jac
 
 
-def _krylov_update(prob, elastic, f, lap, cond, diag, rtol) -> np.ndarray:
+def _krylov_update(prob, elastic, f, lap, cond, diag, rtol, closed):
+    """(dx, M): the GMRES solution of J dx = -f and the preconditioner M ~ J^-1 (near-field SuperLU)."""
     n = f.size
-    sparse_part = scipy.sparse.diags(diag) - prob.dt * cond
+    open_ = (~closed).astype(float)
+    c0 = elastic.self_stiffness
+    sparse_part = scipy.sparse.diags(diag * open_) - prob.dt * (cond @ scipy.sparse.diags(open_))
 
     def apply(v):
-        return sparse_part @ v - prob.dt * (lap @ elastic.apply(v))
+        return sparse_part @ v - prob.dt * (lap @ np.where(closed, c0 * v, elastic.apply(open_ * v)))
 
-    near = elastic.op.near_field(elastic.ix, elastic.iz, 2)
+    mask = scipy.sparse.diags(open_)
+    near = mask @ elastic.op.near_field(elastic.ix, elastic.iz, 2) @ mask + scipy.sparse.diags(c0 * closed)
     precond = splu_preconditioner(sparse_part - prob.dt * (lap @ near))
     op = LinearOperator((n, n), matvec=apply, dtype=float)
     result = gmres_solve(op, -f, precond, rtol=rtol, restart=60, maxiter=600)
     if not result.converged:
         raise np.linalg.LinAlgError(f"GMRES did not converge (relative residual {result.residual:.2e})")
-    return result.x
+    return result.x, precond.matvec
+
+
+def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray, tolerance: float,
+            max_iterations: int) -> tuple[np.ndarray, bool, int]:
+    """Damped Newton on Eq. 29 for a fixed contact set (module docstring); (x, converged, iterations)."""
+    f, p, lap, dt_dw, dg = residual(prob, elastic, x, closed)
+    it = 0
+    for it in range(1, max_iterations + 1):
+        diag = prob.area * (1.0 + prob.demand * dg)
+        cond = _conductance_jacobian(prob, np.where(closed, 0.0, x), p, dt_dw)
+        try:
+            if elastic.matrix is not None:
+                lu = scipy.linalg.lu_factor(_dense(prob, elastic, lap, cond, diag, closed), check_finite=False)
+                dx = scipy.linalg.lu_solve(lu, -f)
+                inverse = partial(scipy.linalg.lu_solve, lu)
+            else:
+                dx, inverse = _krylov_update(prob, elastic, f, lap, cond, diag,
+                                             min(1e-3, tolerance * 1e-1), closed)
+        except (np.linalg.LinAlgError, ValueError):
+            return x, False, it
+        if not np.all(np.isfinite(dx)):
+            return x, False, it
+        scale = np.linalg.norm(inverse(-f)) if elastic.matrix is None else np.linalg.norm(dx)
+        step = 1.0
+        for _ in range(MONOTONICITY_HALVINGS):
+            trial = residual(prob, elastic, x + step * dx, closed)
+            if np.all(np.isfinite(trial[0])) and \
+                    np.linalg.norm(inverse(-trial[0])) <= (1.0 - 0.25 * step) * scale:
+                break
+            step *= 0.5
+        x = x + step * dx
+        f, p, lap, dt_dw, dg = trial
+        if np.linalg.norm(dx) < tolerance * max(np.linalg.norm(x), 1e-300):   # undamped update
+            return x, True, it
+    return x, False, it
+
+
+def start_widths(prob: StepProblem) -> np.ndarray:
+    """Newton's first iterate: w_old, except that an empty cell (a cell the front just opened) starts at half
+    the mean width of its open neighbours. From w = 0 the conductance derivative times the large pressure drop
+    into the empty cell dominates its Jacobian row and sends the iterate to large negative widths, where
+    Newton stalled (front cells of radial cases III and IV)."""
+    w, a, b = prob.w_old, prob.faces.a, prob.faces.b
+    total = np.bincount(a, w[b], w.size) + np.bincount(b, w[a], w.size)
+    count = np.bincount(a, w[b] > 0.0, w.size) + np.bincount(b, w[a] > 0.0, w.size)
+    return np.where((w <= 0.0) & (count > 0), 0.5 * total / np.maximum(count, 1), w)
 
 
 def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_iterations: int,
                w_start: np.ndarray | None = None) -> StepResult:
-    """Newton iterations on Eq. 29 until ||dw|| < tolerance ||w|| (Eq. 32); never raises on failure."""
-    w = (prob.w_old if w_start is None else w_start).astype(float, copy=True)
-    converged = False
-    it = 0
-    f, p, lap, dt_dw, dg = residual(prob, elastic, w)
-    norm = np.linalg.norm(f)
-    for it in range(1, max_iterations + 1):
-        diag = prob.area * (1.0 + prob.demand * dg)
-        cond = _conductance_jacobian(prob, w, p, dt_dw)
-        try:
-            if elastic.matrix is not None:
-                dw = np.linalg.solve(_dense(prob, elastic, lap, cond, diag), -f)
-            else:
-                dw = _krylov_update(prob, elastic, f, lap, cond, diag, rtol=min(1e-3, tolerance * 1e-1))
-        except np.linalg.LinAlgError:
+    """Newton iterations on Eq. 29 until ||dw|| < tolerance ||w|| (Eq. 32), then the contact set is updated
+    (cells with w < 0 closed, closed cells whose fluid pressure exceeds sigma + C w opened) and Newton rerun
+    until it settles (at most CONTACT_PASSES times); never raises on failure."""
+    x = (start_widths(prob) if w_start is None else w_start).astype(float, copy=True)
+    closed = np.zeros(x.size, bool)
+    iterations = 0
+    for _ in range(CONTACT_PASSES):
+        x, converged, it = _newton(prob, elastic, x, closed, tolerance, max_iterations)
+        iterations += it
+        if not converged:
             break
-        if not np.all(np.isfinite(dw)):
+        w, p = _split(prob, elastic, x, closed)
+        to_close = ~closed & (w < -CONTACT_TOLERANCE * float(np.abs(w).max()))
+        to_open = closed & (prob.sigma + elastic.apply(w) < p)
+        if not (to_close.any() or to_open.any()):
             break
-        step = 1.0
-        for _ in range(LINE_SEARCH_HALVINGS):
-            trial = residual(prob, elastic, w + step * dw)
-            trial_norm = np.linalg.norm(trial[0])
-            if trial_norm < norm or not np.isfinite(norm):
-                break
-            step *= 0.5
-        w = w + step * dw
-        f, p, lap, dt_dw, dg = trial
-        norm = trial_norm
-        if np.linalg.norm(dw) < tolerance * max(np.linalg.norm(w), 1e-300):   # undamped update
-            converged = True
-            break
-    f, p, *_ = residual(prob, elastic, w)
+        x = np.where(to_close, (p - prob.sigma) / elastic.self_stiffness, np.where(to_open, 0.0, x))
+        closed = (closed | to_close) & ~to_open
+    f, p, *_ = residual(prob, elastic, x, closed)
+    w = np.where(closed, 0.0, x)
     g, _ = available_fraction(w, prob.w_eps)
     ok = converged and bool(np.all(np.isfinite(f)))
-    return StepResult(w=w, p=p, leaked=prob.area * prob.demand * g, iterations=it, converged=ok, residual=f)
+    return StepResult(w=w, p=p, leaked=prob.area * prob.demand * g, iterations=iterations, converged=ok,
+                      residual=f)

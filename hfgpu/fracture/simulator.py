@@ -2,9 +2,13 @@
 
 Each step [t, t + dt] solves the implicit elasticity-lubrication-leak-off system for the widths of the
 active cells (Newton, :mod:`newton`), then opens the cells the front criterion selects (:mod:`front`) and
-chooses the next step by Eq. 35. Steps land on schedule breakpoints, output times and the end time; a step
-whose Newton iteration fails is retried with half the step (``max_step_retries`` times, then
-SimulationError naming time, cell and residual). The injected volume of a step is exact
+chooses the next step by Eq. 35 with V_T the larger of the last opening's speed (Eq. 34) and the sub-grid
+front's measured speed over the step just taken. Steps land on schedule breakpoints, output times and the end
+time; a step whose Newton iteration fails, or in which the sub-grid front (front.front_distances) moved more
+than ``max_front_advance`` cells, is redone with half the step (``max_step_retries`` times; then a Newton
+failure raises SimulationError naming time, cell and residual, a long advance is accepted), so the front
+does not over-run on long steps and results do not depend on the output spacing. Cells squeezed shut stay
+closed at w = 0 (contact, newton.solve_step). The injected volume of a step is exact
 (Schedule.mean_rate), leak-off is Carter's law integrated exactly (:mod:`leakoff`), and the flux form
 conserves volume, so injected = stored + leaked to the Newton tolerance at every step.
 
@@ -36,7 +40,7 @@ from ..records import BalanceRecord, FractureSnapshot, GridFrame
 from .coarsen import coarsen
 from .config import FractureNumerics
 from .elasticity import ElasticityOperator
-from .front import DIRECTIONS, TipModel, cells_to_open, edge_cells, invert_tip, tip_velocity
+from .front import DIRECTIONS, TipModel, cells_to_open, edge_cells, front_distances
 from .leakoff import carter_volume
 from .lubrication import build_faces
 from .mesh import GROW, Grid
@@ -119,7 +123,8 @@ class _Engine:
         self.t = self.t0
         self.v_front = power * r0 / self.t0
         self.t_front = self.t0
-        self.steps = self.newton_iterations = self.retries = self.coarsenings = 0
+        self.steps = self.newton_iterations = self.retries = self.rejected = self.coarsenings = 0
+        self.v_tip = 0.0
         self.max_balance_error = 0.0
 
     def _properties(self) -> None:
@@ -144,12 +149,15 @@ class _Engine:
 
     # ------------------------------------------------------------------------------------------
     def step(self, dt: float) -> float:
-        """Advance by dt (halved on Newton failure); returns the step taken."""
+        """Advance by dt; returns the step taken. A step whose Newton iteration fails, or in which the front
+        moves more than ``max_front_advance`` cells (``_front_advance``), is redone with half the step."""
         g = self.grid
         sel = (self.rows, self.cols)
         w_old = g["w"][sel]
         tau = g["opened"][sel]
         filled = g["filled"][sel] if self.num.partial_tip_cells else None
+        reach_old = self._front_reach(g["w"], g["p"], self.t)
+        h = min(self.dx, self.dz)
         for attempt in range(self.num.max_step_retries + 1):
             source = np.zeros(w_old.size)
             source[self.inj] = self.schedule.mean_rate(self.t, self.t + dt) * dt
@@ -160,13 +168,17 @@ class _Engine:
             res = solve_step(prob, self.elastic, self.num.newton_tolerance, self.num.newton_max_iterations)
             self.newton_iterations += res.iterations
             if res.converged:
-                break
-            if attempt == self.num.max_step_retries:
+                advance = self._front_advance(reach_old, res.w, res.p, self.t + dt)
+                if advance <= self.num.max_front_advance * h or attempt == self.num.max_step_retries:
+                    break
+                self.rejected += 1
+            elif attempt == self.num.max_step_retries:
                 worst = int(np.nanargmax(np.where(np.isfinite(res.residual), np.abs(res.residual), np.inf)))
                 raise SimulationError("Newton iteration failed after the allowed step retries",
                                       time=self.t + dt, cell=(int(self.ix[worst]), int(self.iz[worst])),
                                       residual=float(np.abs(res.residual[worst]) / self.area))
-            self.retries += 1
+            else:
+                self.retries += 1
             dt *= 0.5
         if not (np.all(np.isfinite(res.w)) and np.all(np.isfinite(res.p))):
             raise SimulationError("non-finite width or pressure", time=self.t + dt)
@@ -175,9 +187,25 @@ class _Engine:
         g["p"][sel] = res.p
         g["leak_rate"][sel] = res.leaked / (self.area * dt)
         self.leaked_total += float(res.leaked.sum())
+        self.v_tip = advance / dt
         self.steps += 1
         self._advance_front()
         return dt
+
+    def _front_reach(self, w: np.ndarray, p: np.ndarray, t: float) -> np.ndarray:
+        """Largest sub-grid front distance s (Eq. 33 inverted, front.front_distances) of every box cell,
+        capped at 2 cells; 0 where a cell faces no inactive cell."""
+        g = self.grid
+        dist = front_distances(self.tip, g["active"], w, p, self.kprime_box, g["reached"], t, self.dx, self.dz)
+        return np.minimum(np.nan_to_num(np.fmax.reduce(dist), nan=0.0), 2.0 * max(self.dx, self.dz))
+
+    def _front_advance(self, reach_old: np.ndarray, w: np.ndarray, p: np.ndarray, t: float) -> float:
+        """Largest distance any front point moved over a step that ends at t with active widths w and
+        pressures p (the measured tip advance of Eq. 34)."""
+        g, sel = self.grid, (self.rows, self.cols)
+        w_box, p_box = g["w"].copy(), g["p"].copy()
+        w_box[sel], p_box[sel] = w, p
+        return float(np.max(self._front_reach(w_box, p_box, t) - reach_old))
 
     def _advance_front(self) -> None:
         """Open the cells the front criterion selects (Eq. 33) and record the tip speed (Eq. 34)."""
@@ -229,12 +257,14 @@ class _Engine:
         self._rebuild()
 
     def next_dt(self, dt_prev: float) -> float:
-        """Eq. 35, dt = lambda min(dx, dz) / V_T, with V_T the latest front speed, no larger than the
-        bound h / (time since the last opening) it must satisfy, and growth limited by max_step_growth."""
+        """Eq. 35, dt = lambda min(dx, dz) / V_T, with V_T the larger of the latest opening's front speed
+        (Eq. 34; no larger than h / (time since that opening)) and the sub-grid front's measured speed over
+        the last step, and growth limited by max_step_growth."""
         h = min(self.dx, self.dz)
         v = self.v_front
         if self.t > self.t_front:
             v = min(v, h / (self.t - self.t_front))
+        v = max(v, self.v_tip)
         return min(self.num.time_step_relaxation * h / v, self.num.max_step_growth * dt_prev)
 
     # ------------------------------------------------------------------------------------------
@@ -260,64 +290,96 @@ class _Engine:
         """Sub-grid front: distances r + s from the injection point at the edge cells (s from the inverted
         tip asymptote, capped at one cell) and the extents up (-z), down (+z), left (-x), right (+x)."""
         g = self.grid
-        act, w, p = g["active"], g["w"], g["p"]
         xo, zo = g.offsets()
-        edge = edge_cells(act)
-        radii = []
-        ext = {"right": 0.0, "left": 0.0, "down": 0.0, "up": 0.0}
-        names = ("right", "left", "down", "up")
-        nz, nx = act.shape
-        for k, i in zip(*np.nonzero(edge)):
-            best = 0.0
-            for name, (dk, di) in zip(names, DIRECTIONS):
-                kk, ii = k + dk, i + di
-                if 0 <= kk < nz and 0 <= ii < nx and act[kk, ii]:
-                    continue
-                h = self.dz if dk else self.dx
-                kb, ib = k - dk, i - di
-                v = 0.0
-                if 0 <= kb < nz and 0 <= ib < nx and act[kb, ib]:
-                    wf = max(w[kb, ib], 0.0) + max(w[k, i], 0.0)
-                    v = max(wf**2 / (4.0 * self.mu_prime) * (p[kb, ib] - p[k, i]) / h, 0.0)
-                v = float(tip_velocity(self.tip, np.array(v), h, self.t, np.array(g["reached"][k, i])))
-                s = min(float(invert_tip(self.tip, np.array(self.kprime_box[k, i]), np.array(w[k, i]),
-                                         np.array(v))), h)
-                best = max(best, s)
-                coord = (zo[k, i] * dk if dk else xo[k, i] * di) + s
-                ext[name] = max(ext[name], coord)
-            radii.append(math.hypot(xo[k, i], zo[k, i]) + best)
-        radii = np.array(radii)
+        dist = front_distances(self.tip, g["active"], g["w"], g["p"], self.kprime_box, g["reached"], self.t,
+                               self.dx, self.dz)
+        best = np.zeros(xo.shape)
+        ext = {}
+        for name, (dk, di), s in zip(("right", "left", "down", "up"), DIRECTIONS, dist):
+            s = np.minimum(s, self.dz if dk else self.dx)
+            coord = (zo * dk if dk else xo * di) + s
+            ext[name] = max(float(np.nanmax(coord)) if np.isfinite(coord).any() else 0.0, 0.0)
+            best = np.fmax(best, s)
+        edge = edge_cells(g["active"])
+        radii = np.hypot(xo, zo)[edge] + best[edge]
         return dict(radius=float(radii.mean()), radius_min=float(radii.min()), radius_max=float(radii.max()),
-                    area_radius=math.sqrt(act.sum() * self.area / math.pi), **ext)
+                    area_radius=math.sqrt(g["active"].sum() * self.area / math.pi), **ext)
+
+    # -- checkpoints ------------------------------------------------------------------------------
+    #: Attributes (numbers or arrays) a checkpoint carries besides the grid: list every new persistent one here.
+    STATE_ATTRIBUTES = ("t", "t0", "v_front", "t_front", "leaked_total", "steps", "newton_iterations", "retries",
+                        "coarsenings", "max_balance_error", "v_tip", "rejected")
+
+    def state(self) -> dict:
+        """Everything needed to continue from now (a checkpoint): STATE_ATTRIBUTES, the grid (placement and every
+        field) and the capacity of the elasticity kernel cache (so FFT products keep their size, hence their
+        round-off). Derived systems (active set, faces, C, properties) are rebuilt by :meth:`restore`."""
+        g = self.grid
+        return {**{name: getattr(self, name) for name in self.STATE_ATTRIBUTES},
+                "grid": {"dx": g.dx, "dz": g.dz, "x_inj": g.x_inj, "z_inj": g.z_inj, "ix0": g.ix0, "iz0": g.iz0,
+                         "fields": {name: array.copy() for name, array in g.fields.items()}},
+                "elasticity_capacity": np.array(self.op._capacity)}
+
+    def restore(self, state: dict) -> None:
+        """Continue from a :meth:`state` (of a run of the same scene): same fields, same systems."""
+        for name in self.STATE_ATTRIBUTES:
+            setattr(self, name, np.array(state[name]) if isinstance(state[name], np.ndarray) else state[name])
+        s = state["grid"]
+        self.grid = Grid(s["dx"], s["dz"], s["x_inj"], s["z_inj"], int(s["ix0"]), int(s["iz0"]),
+                         {name: np.array(array) for name, array in s["fields"].items()})
+        self.dx, self.dz = self.grid.dx, self.grid.dz
+        self.area = self.dx * self.dz
+        self.op = ElasticityOperator(self.dx, self.dz, self.e_prime)
+        self.op._ensure(*(int(n) for n in state["elasticity_capacity"]))
+        self._properties()
+        self._rebuild()
 
 
 def _targets(scene, t0: float) -> tuple[list[float], set[float]]:
-    """(times steps must land on, output times): schedule breakpoints, every ``output.every`` and the end."""
+    """(times steps must land on, output times): schedule breakpoints, every ``output.every`` and the end.
+    Times within 1e-9 (relative) of each other are one target, so a breakpoint that coincides with an output
+    time up to round-off (e.g. 3 x 0.1 s and 0.3 s) gives one step target and the output keeps its snapshot,
+    stamped with the output time."""
     end = scene.run.end_time
     every = scene.output.every
     outputs = {every * k for k in range(1, int(math.floor(end / every + 1e-9)) + 1)} | {end}
     outputs = {t for t in outputs if t0 < t <= end}
-    times = outputs | {b for b in scene.injection.schedule.breakpoints() if t0 < b < end}
+    breaks = [b for b in scene.injection.schedule.breakpoints() if t0 < b < end]
+    times = sorted(outputs)
+    for b in breaks:
+        if all(abs(b - t) > 1e-9 * t for t in times):
+            times.append(b)
     return sorted(times), outputs
 
 
-def simulate(scene, sink, progress: Callable[[float], None] | None = None) -> dict:
+def simulate(scene, sink, progress: Callable[[float], None] | None = None, checkpoint=None,
+             resume: dict | None = None) -> dict:
     """Run the planar-3D fracture model of ``scene`` to ``run.end_time`` (paper sections 2.2, 3.1).
 
     Calls ``sink.fracture_balance(BalanceRecord)`` after every accepted step and
     ``sink.fracture_snapshot(FractureSnapshot)`` at every ``output.every`` and at the end; ``progress(t)``
     after each step. With ``mesh.max_cells_across`` set, the grid is merged 3x3 each time the footprint
     spans more cells than that along x or z (snapshots then carry the coarser frame). Returns a summary:
-    time, steps, newton_iterations, retries, coarsenings, dx, dz (final cell sizes), cells, the sub-grid
+    time, steps, newton_iterations, retries, rejected (steps redone for a too-long front advance),
+    coarsenings, dx, dz (final cell sizes), cells, the sub-grid
     front (radius, radius_min, radius_max, area_radius, up, down, left, right), w_inlet, p_inlet, the final
     balance (injected, stored, leaked) and max_balance_error (relative).
+
+    Checkpoints (hfgpu.io.checkpoint): after the first step that ends at or past each interval,
+    ``checkpoint.save(t, state)`` gets {"engine": _Engine.state(), "dt": next step, "target": index of the
+    step target}; ``resume`` (such a state) continues from it, with the same steps as an uninterrupted run.
     """
     _check_scene(scene)
     numerics = scene.fracture if scene.fracture is not None else FractureNumerics()
     eng = _Engine(scene, numerics)
     targets, outputs = _targets(scene, eng.t0)
     dt = numerics.time_step_relaxation * min(eng.dx, eng.dz) / eng.v_front
-    for target in targets:
+    first = 0
+    if resume is not None:
+        eng.restore(resume["engine"])
+        dt, first = resume["dt"], int(resume["target"])
+    for index in range(first, len(targets)):
+        target = targets[index]
         while eng.t < target * (1 - 1e-12):
             remaining = target - eng.t
             step = min(dt, remaining)
@@ -333,13 +395,15 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None) -> di
             if progress is not None:
                 progress(eng.t)
             dt = eng.next_dt(dt if taken == step else taken)
+            if checkpoint is not None and checkpoint.due(eng.t):
+                checkpoint.save(eng.t, {"engine": eng.state(), "dt": dt, "target": index})
         if target in outputs:
             sink.fracture_snapshot(eng.snapshot())
     g = eng.grid
     inj = (eng.rows[eng.inj], eng.cols[eng.inj])
     final = eng.balance()
     return dict(time=eng.t, t0=eng.t0, steps=eng.steps, newton_iterations=eng.newton_iterations,
-                retries=eng.retries, coarsenings=eng.coarsenings, dx=eng.dx, dz=eng.dz,
+                retries=eng.retries, rejected=eng.rejected, coarsenings=eng.coarsenings, dx=eng.dx, dz=eng.dz,
                 cells=int(g["active"].sum()), w_inlet=float(g["w"][inj]),
                 p_inlet=float(g["p"][inj]), injected=final.injected, stored=final.stored,
                 leaked=final.leaked, max_balance_error=eng.max_balance_error, **eng.front())

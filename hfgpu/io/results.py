@@ -9,6 +9,7 @@ Layout (docs/results-format.md is the full contract; extend, never rename)::
     /proppant/snapshots/000000 ...   attrs time, dx, dz, x0, z0, n_parcels; per-parcel and grid datasets
     /proppant/balance       time, injected, in_domain, outflow, screened_out (1-D, appended)
     /summary                attrs status, message, and the simulator's scalar summary values
+    /checkpoint             attrs time and record counts; state/...: the simulator's state (removed when complete)
 
 Integrity: the file is open only while a snapshot is written. A snapshot is built under a temporary
 name (``_incomplete``) and moved to its final zero-padded name once complete, then the file is flushed
@@ -16,6 +17,12 @@ and closed; balance records are buffered and written with each snapshot (and at 
 any moment therefore leaves every completed snapshot readable; a leftover ``_incomplete`` group is
 ignored by the reader. ``status`` is "running" until :meth:`ResultsWriter.close` writes "complete" or
 "failed: <message>"; a file still saying "running" after its run ended was interrupted.
+
+Checkpoints (:meth:`ResultsWriter.write_checkpoint`, :mod:`hfgpu.io.checkpoint`) are built under
+``_checkpoint_new``, marked complete, flushed, and only then swapped for ``/checkpoint``; a kill between the
+removal of the old one and the move leaves the complete new one, which :meth:`ResultsWriter.reopen` takes.
+The file keeps its free space across openings (HDF5 persistent free-space manager), so replacing a checkpoint
+reuses the old one's space instead of growing the file.
 """
 
 from __future__ import annotations
@@ -30,12 +37,15 @@ import h5py
 import numpy as np
 
 from ..errors import HfgpuError
+from .checkpoint import read_tree, write_tree
 from ..records import (BalanceRecord, FractureSnapshot, GridFrame, ProppantSnapshot,
                        SolidBalanceRecord)
 
 FORMAT = "hfgpu-results"
 FORMAT_VERSION = 1
 INCOMPLETE = "_incomplete"
+CHECKPOINT = "checkpoint"
+NEW_CHECKPOINT = "_checkpoint_new"
 
 #: Units of every dataset name the writer knows (SI; "1" is dimensionless, "" is text or a label).
 UNITS = {
@@ -58,7 +68,10 @@ _COMPRESS_ABOVE = 4096  # elements; smaller arrays are stored plainly
 
 
 def _open(path: Path, mode: str) -> h5py.File:
-    """h5py file without HDF5 file locking, so a reader can look at a file while a run writes it."""
+    """h5py file without HDF5 file locking, so a reader can look at a file while a run writes it; a new file
+    tracks its free space persistently (a replaced checkpoint's space is reused in later openings)."""
+    if mode == "w":
+        return h5py.File(path, mode, locking=False, fs_strategy="fsm", fs_persist=True, fs_threshold=1)
     return h5py.File(path, mode, locking=False)
 
 
@@ -66,17 +79,14 @@ class ResultsWriter:
     """Output sink writing an HDF5 results file (the sink methods of hfgpu/records.py).
 
     The file at ``path`` is created (replaced if it exists) with the scene text and status "running".
-    Use as a context manager, or call :meth:`close` with the final status.
+    Use as a context manager, or call :meth:`close` with the final status. :meth:`reopen` continues a file
+    from its checkpoint instead.
     """
 
     def __init__(self, path: str | Path, scene: Any):
         from .. import __version__
 
-        self.path = Path(path)
-        self._counts = {"fracture": 0, "proppant": 0}
-        self._pending: dict[str, list[tuple[float, ...]]] = {"fracture": [], "proppant": []}
-        self._last_time = 0.0
-        self._closed = False
+        self._start(Path(path), {"fracture": 0, "proppant": 0}, 0.0)
         try:
             with _open(self.path, "w") as f:
                 f.attrs.update(format=FORMAT, format_version=FORMAT_VERSION, hfgpu_version=__version__,
@@ -84,6 +94,49 @@ class ResultsWriter:
                 _dataset(f, "scene", np.array(getattr(scene, "source", "") or "", dtype=h5py.string_dtype()))
         except OSError as exc:
             raise HfgpuError(f"cannot create the results file '{self.path}': {exc}") from None
+
+    def _start(self, path: Path, counts: dict[str, int], last_time: float) -> None:
+        self.path = path
+        self._counts = counts
+        self._pending: dict[str, list[tuple[float, ...]]] = {"fracture": [], "proppant": []}
+        self._last_time = last_time
+        self._closed = False
+
+    @classmethod
+    def reopen(cls, path: str | Path) -> tuple["ResultsWriter", float, dict]:
+        """(writer, time, state): continue the results file ``path`` from its checkpoint. Snapshots and
+        balance rows written after the checkpoint are dropped, ``/summary`` removed and the status set back
+        to "running"; ``state`` is the tree the simulator saved at simulated time ``time`` [s]. Raises
+        :class:`HfgpuError` for a file that is not a results file or holds no checkpoint."""
+        path = Path(path)
+        try:
+            f = _open(path, "a")
+        except OSError as exc:
+            raise HfgpuError(f"cannot open the results file '{path}' to resume: {exc}") from None
+        with f:
+            if f.attrs.get("format") != FORMAT:
+                raise HfgpuError(f"'{path}' is not an hfgpu results file (no format=\"{FORMAT}\" attribute)")
+            group = _checkpoint(f, finish_swap=True)
+            if group is None:
+                raise HfgpuError(f"'{path}' holds no checkpoint to resume from (status "
+                                 f"\"{f.attrs.get('status', 'running')}\"); run the scene again without --resume")
+            a = group.attrs
+            counts = {physics: int(a[f"{physics}_snapshots"]) for physics in ("fracture", "proppant")}
+            for physics in counts:
+                parent = f.get(f"{physics}/snapshots")
+                for name in list(parent) if parent is not None else []:
+                    if not name.isdigit() or int(name) >= counts[physics]:
+                        del parent[name]
+                balance = f.get(f"{physics}/balance")
+                for ds in balance.values() if balance is not None else []:
+                    ds.resize((int(a[f"{physics}_balance_rows"]),))
+            f.pop("summary", None)
+            f.attrs["status"] = "running"
+            time, state = float(a["time"]), read_tree(group["state"])
+            f.flush()
+        writer = cls.__new__(cls)
+        writer._start(path, counts, time)
+        return writer, time, state
 
     # sink methods ------------------------------------------------------------------------------
 
@@ -114,10 +167,31 @@ class ResultsWriter:
         """Buffer one solid balance row; rows are written with the next snapshot or at close."""
         self._balance("proppant", tuple(float(getattr(record, k)) for k in PROPPANT_BALANCE))
 
+    def write_checkpoint(self, time: float, state: dict) -> None:
+        """Replace ``/checkpoint`` with the simulator's ``state`` at simulated time ``time`` [s], after writing the
+        buffered balance rows; records the snapshot and balance-row counts it belongs to (see the module
+        docstring for the atomic swap)."""
+        with _open(self.path, "a") as f:
+            self._write_balance(f)
+            f.pop(NEW_CHECKPOINT, None)
+            group = f.create_group(NEW_CHECKPOINT)
+            write_tree(group.create_group("state"), state)
+            counts = {f"{physics}_snapshots": n for physics, n in self._counts.items()}
+            for physics in self._counts:
+                rows = f.get(f"{physics}/balance/time")
+                counts[f"{physics}_balance_rows"] = rows.shape[0] if rows is not None else 0
+            group.attrs.update(time=float(time), **counts)
+            group.attrs["complete"] = True
+            f.flush()
+            f.pop(CHECKPOINT, None)
+            f.move(NEW_CHECKPOINT, CHECKPOINT)
+            f.flush()
+
     # ending -----------------------------------------------------------------------------------
 
     def close(self, status: str = "complete", summary: dict[str, Any] | None = None) -> None:
-        """Write buffered rows, ``/summary`` (status, snapshot counts, scalar ``summary`` values), close."""
+        """Write buffered rows, ``/summary`` (status, snapshot counts, scalar ``summary`` values), close; a
+        complete run's checkpoint is removed (a failed run keeps it, to resume from)."""
         if self._closed:
             return
         self._closed = True
@@ -125,6 +199,9 @@ class ResultsWriter:
             self._write_balance(f)
             for physics in self._counts:
                 f.pop(f"{physics}/snapshots/{INCOMPLETE}", None)
+            if status == "complete":
+                f.pop(CHECKPOINT, None)
+                f.pop(NEW_CHECKPOINT, None)
             group = f.require_group("summary")
             values = {k: v for k, v in (summary or {}).items() if _is_scalar(v)}
             values.update(status=status, sim_time=self._last_time,
@@ -207,6 +284,20 @@ def _is_scalar(value: Any) -> bool:
     return isinstance(value, (bool, int, float, str, np.integer, np.floating))
 
 
+def _checkpoint(f: h5py.File, finish_swap: bool = False) -> h5py.Group | None:
+    """The file's checkpoint group: ``/checkpoint``, else a complete ``_checkpoint_new`` left by a run killed
+    in the middle of the swap (moved into place when ``finish_swap``); None when there is none."""
+    if CHECKPOINT in f:
+        return f[CHECKPOINT]
+    new = f.get(NEW_CHECKPOINT)
+    if new is None or not new.attrs.get("complete", False):
+        return None
+    if finish_swap:
+        f.move(NEW_CHECKPOINT, CHECKPOINT)
+        return f[CHECKPOINT]
+    return new
+
+
 # ----------------------------------------------------------------------------------------------
 # reading
 
@@ -244,6 +335,7 @@ class Results:
     status: "complete", "failed: <message>", or "running" (still being written, or interrupted).
     summary: the ``/summary`` attributes (empty until the run closed the file).
     fracture_balance / proppant_balance: dicts of 1-D arrays (empty dict when absent).
+    checkpoint_time: simulated time [s] of the checkpoint the file holds (None when it holds none).
     """
 
     path: Path
@@ -255,6 +347,7 @@ class Results:
     proppant_snapshots: Snapshots
     fracture_balance: dict[str, np.ndarray] = field(repr=False)
     proppant_balance: dict[str, np.ndarray] = field(repr=False)
+    checkpoint_time: float | None = None
 
     @functools.cached_property
     def scene(self):
@@ -285,7 +378,13 @@ def open_results(path: str | Path) -> Results:
             proppant_snapshots=_snapshots(f, path, "proppant", _proppant_snapshot),
             fracture_balance=_balance(f, "fracture"),
             proppant_balance=_balance(f, "proppant"),
+            checkpoint_time=_checkpoint_time(f),
         )
+
+
+def _checkpoint_time(f: h5py.File) -> float | None:
+    group = _checkpoint(f)
+    return float(group.attrs["time"]) if group is not None else None
 
 
 def _snapshots(f: h5py.File, path: Path, physics: str, build: Callable) -> Snapshots:

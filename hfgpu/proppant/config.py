@@ -30,11 +30,14 @@ from typing import Any
 import numpy as np
 
 from ..errors import SceneError
+from ..presets import BALANCED, PRESETS, Preset
 from ..scene_reader import Table
 from .sieve import DISTRIBUTIONS, SizeDistribution, make_distribution, sieve_range
 
 GEOMETRY_KINDS = ("box", "slot", "field")
 PORT_KINDS = ("point", "segment", "annulus")
+#: Directions an inlet's slurry may enter along as a jet (``jet``; "none": a source without momentum).
+JET_DIRECTIONS = ("none", "+x", "-x", "+z", "-z")
 BACKENDS = ("taichi", "numpy")
 
 
@@ -45,7 +48,10 @@ class Port:
     kind "point": the cell holding (x, depth); "segment": the cells crossed by the segment (x, depth) ->
     (x_end, depth_end); "annulus": the cells whose centres lie at a distance in [inner_radius, outer_radius]
     from (x, depth) (the cells around a perforation). ``share`` weights an inlet's part of the slurry rate
-    (shares are normalised over the inlets).
+    (shares are normalised over the inlets). ``jet`` (inlets): "none" (default), the slurry appears in the
+    cells without momentum (a perforation feeding the fracture from its face); "+x", "-x", "+z" or "-z", it
+    enters through the domain's end wall along that axis (depth +z downward) at the speed Q_inlet / A, A the
+    inlet's cross-section normal to the jet (:meth:`hfgpu.proppant.injection.Injector.jet_momentum`).
     """
 
     kind: str
@@ -56,6 +62,7 @@ class Port:
     inner_radius: float = 0.0
     outer_radius: float = 0.0
     share: float = 1.0
+    jet: str = "none"
 
 
 @dataclass(frozen=True)
@@ -111,12 +118,12 @@ class MppicNumerics:
     backend: str = "taichi"
     arch: str | None = None
     particles_per_parcel: float | None = None
-    parcels_per_cell: int = 16
-    particle_substeps: int = 4
-    c_max: float = 0.5
-    dt_max: float = 0.05
+    parcels_per_cell: int = BALANCED.parcels_per_cell
+    particle_substeps: int = BALANCED.particle_substeps
+    c_max: float = BALANCED.c_max
+    dt_max: float = BALANCED.dt_max
     max_step_retries: int = 6
-    simple_tolerance: float = 1e-5
+    simple_tolerance: float = BALANCED.simple_tolerance
     simple_max_iterations: int = 50
     gravity: float = 9.81
     slurry_viscosity: bool = True
@@ -147,7 +154,7 @@ def parse_proppant_setup(top: Table, run: Any, fluid: Any, mesh: Any) -> Proppan
     else:
         geometry = _parse_geometry(top.table("geometry"))
     classes = _parse_classes(top)
-    numerics, params = _parse_mppic(top.table("mppic", {}))
+    numerics, params = _parse_mppic(top.table("mppic", {}), PRESETS[run.preset])
     if geometry.kind == "field":
         _check_field_spacing(geometry, mesh)
     return ProppantSetup(geometry=geometry, classes=classes, numerics=numerics, params=params)
@@ -189,7 +196,8 @@ def _parse_port(t: Table, inlet: bool) -> Port:
         values.update(outer_radius=t.quantity("outer_radius", "length", minimum=values["inner_radius"],
                                               exclusive_minimum=True))
     if inlet:
-        values.update(share=t.number("share", 1.0, minimum=0.0, exclusive_minimum=True))
+        values.update(share=t.number("share", 1.0, minimum=0.0, exclusive_minimum=True),
+                      jet=t.choice("jet", JET_DIRECTIONS, "none"))
     t.finish()
     return Port(**values)
 
@@ -229,7 +237,7 @@ def _spacing(axis: np.ndarray) -> float:
 
 
 def _check_field_spacing(geometry: Geometry, mesh: Any) -> None:
-    for name, axis, size in (("x", geometry.field_x, mesh.dx), ("z", geometry.field_z, mesh.dz)):
+    for name, axis, size in zip("xz", (geometry.field_x, geometry.field_z), mesh.scene_cell_size):
         if abs(_spacing(axis) - size) > 1e-9 * size:
             raise SceneError("mesh.cell_size", size, f"must equal the width file's {name} spacing "
                              f"{_spacing(axis):g} m for a \"field\" geometry")
@@ -286,7 +294,8 @@ def _parse_size(t: Table) -> SizeDistribution:
 # [mppic]
 
 
-def _parse_mppic(t: Table) -> tuple[MppicNumerics, Any]:
+def _parse_mppic(t: Table, preset: Preset = BALANCED) -> tuple[MppicNumerics, Any]:
+    """``[mppic]``: numerics (the preset gives the defaults of its knobs) and closure constants."""
     d = MppicNumerics()
     positive = dict(minimum=0.0, exclusive_minimum=True)
     backend = t.choice("backend", BACKENDS, d.backend)
@@ -297,12 +306,12 @@ def _parse_mppic(t: Table) -> tuple[MppicNumerics, Any]:
         backend=backend,
         arch=arch,
         particles_per_parcel=t.number("particles_per_parcel", None, minimum=1.0),
-        parcels_per_cell=t.integer("parcels_per_cell", d.parcels_per_cell, minimum=1),
-        particle_substeps=t.integer("particle_substeps", d.particle_substeps, minimum=1, maximum=1000),
-        c_max=t.number("c_max", d.c_max, maximum=1.0, exclusive_maximum=True, **positive),
-        dt_max=t.quantity("dt_max", "time", d.dt_max, **positive),
+        parcels_per_cell=t.integer("parcels_per_cell", preset.parcels_per_cell, minimum=1),
+        particle_substeps=t.integer("particle_substeps", preset.particle_substeps, minimum=1, maximum=1000),
+        c_max=t.number("c_max", preset.c_max, maximum=1.0, exclusive_maximum=True, **positive),
+        dt_max=t.quantity("dt_max", "time", preset.dt_max, **positive),
         max_step_retries=t.integer("max_step_retries", d.max_step_retries, minimum=0, maximum=30),
-        simple_tolerance=t.number("simple_tolerance", d.simple_tolerance, maximum=0.1, **positive),
+        simple_tolerance=t.number("simple_tolerance", preset.simple_tolerance, maximum=0.1, **positive),
         simple_max_iterations=t.integer("simple_max_iterations", d.simple_max_iterations, minimum=1),
         gravity=t.quantity("gravity", "acceleration", d.gravity, minimum=0.0),
         slurry_viscosity=t.boolean("slurry_viscosity", d.slurry_viscosity),

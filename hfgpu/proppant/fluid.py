@@ -98,7 +98,10 @@ class StepInfo:
     volumes over the step [m^3]: injected (sources), leaked (s_l dA dt), outflow (through outlet cells),
     stored (change of fluid volume theta_f w dA in open cells), dropped (fluid in cells that closed), opened
     (fluid theta_f w dA placed in cells that opened during the step: a storage source, see FluidSolver.step).
-    Balance: injected + opened = stored + leaked + outflow to round-off.
+    supplied: fluid a connected region without outlet needed beyond its sources because its prescribed width
+    grows faster than they fill it (a width history inconsistent with the injected volume; spread over the
+    region, see FluidSolver._supply_mismatch), negative when it holds less.
+    Balance: injected + opened + supplied = stored + leaked + outflow to round-off.
     """
 
     iterations: int
@@ -111,6 +114,7 @@ class StepInfo:
     stored: float
     dropped: float
     opened: float
+    supplied: float = 0.0
 
 
 class CourantLimitExceeded(SimulationError):
@@ -159,6 +163,12 @@ class FluidSolver:
     def factorisations(self) -> int:
         """LU factorisations of the pressure-correction matrix so far (the rest were preconditioned CG)."""
         return self._linear.factorisations
+
+    @property
+    def linear(self) -> "_CorrectionSolver":
+        """The pressure-correction solver, whose LU factors carry over between steps (its state() and restore()
+        serve checkpoints)."""
+        return self._linear
 
     # -- grid -------------------------------------------------------------------------------------
 
@@ -210,7 +220,8 @@ class FluidSolver:
              force_x: np.ndarray | None = None, force_z: np.ndarray | None = None,
              sources: np.ndarray | None = None, leakoff: np.ndarray | None = None,
              outlets: np.ndarray | None = None, outlet_pressure: float | np.ndarray = 0.0,
-             drag_x: np.ndarray | None = None, drag_z: np.ndarray | None = None) -> StepInfo:
+             drag_x: np.ndarray | None = None, drag_z: np.ndarray | None = None,
+             momentum_x: np.ndarray | None = None, momentum_z: np.ndarray | None = None) -> StepInfo:
         """Advance ``state`` by dt (Algorithm 1); updates state in place and returns a :class:`StepInfo`.
 
         theta_p (nz, nx): particle volume fraction at the new level (default 0; see _fluid_fraction); force_x (nz, nx+1),
@@ -220,7 +231,10 @@ class FluidSolver:
         (nz+1, nx): optional drag coefficient beta = sum n rho_p V_p D_p I / V_face [kg/(m^3 s)] on the faces;
         when given, the force is linearised about the old fluid velocity, F = F^o + beta (u - u^o), and the
         beta part is taken implicitly (see _implicit_drag): explicitly a packed bed's drag limits dt to about
-        2 rho_f theta_f / beta.
+        2 rho_f theta_f / beta. momentum_x (nz, nx+1), momentum_z (nz+1, nx): optional momentum the inlets' fluid
+        carries into each face control volume per unit density [m^4/s^2] (the inlet source of Eq. 8 / 26, e.g.
+        :meth:`hfgpu.proppant.injection.Injector.jet_momentum`), added to the face's drive as
+        m / (w_f dx dz) [m/s^2] (_momentum_force).
         Raises :class:`CourantLimitExceeded` (state untouched) when dt breaks Eq. 42 with the old
         velocities, :class:`SceneError` for malformed input, :class:`SimulationError` when the loop does
         not converge.
@@ -237,6 +251,11 @@ class FluidSolver:
         leakoff = self._check_cell("leakoff", leakoff, default=0.0, lower=0.0, closed_zero=True)
         force_x = self._check_array("force_x", force_x, (nz, nx + 1))
         force_z = self._check_array("force_z", force_z, (nz + 1, nx))
+        if momentum_x is not None or momentum_z is not None:
+            force_x = force_x + _momentum_force(self._check_array("momentum_x", momentum_x, (nz, nx + 1)),
+                                                grid.width, 1, self.rho_f, dx * dz)
+            force_z = force_z + _momentum_force(self._check_array("momentum_z", momentum_z, (nz + 1, nx)),
+                                                grid.width, 0, self.rho_f, dx * dz)
         if drag_x is not None or drag_z is not None:
             drag_x = self._check_array("drag_x", drag_x, (nz, nx + 1))
             drag_z = self._check_array("drag_z", drag_z, (nz + 1, nx))
@@ -262,6 +281,7 @@ class FluidSolver:
         fixed_rate = (np.where(active, q_new - q_old, 0.0) * grid.cell_area / dt
                       + leakoff * grid.cell_area - sources)
 
+        mismatch = self._supply_mismatch(fixed_rate, outlet, np.where(opened, 0.0, grid.width - state.width))
         fixed = outlet | self._pinned_cells(outlet)
         unknown = active & ~fixed
         number = np.full((nz, nx), -1)
@@ -310,12 +330,37 @@ class FluidSolver:
             stored=float(np.sum(np.where(active, q_new - q_old, 0.0)) + np.sum(np.where(opened, q_new, 0.0)))
             * grid.cell_area,
             dropped=float(np.sum(np.where(active, 0.0, q_old))) * grid.cell_area,
-            opened=float(np.sum(np.where(opened, q_new, 0.0))) * grid.cell_area)
+            opened=float(np.sum(np.where(opened, q_new, 0.0))) * grid.cell_area,
+            supplied=mismatch * dt)
         state.u, state.v, state.p = u, v, p
         state.theta_f, state.width = theta_f, grid.width.copy()
         return info
 
     # -- helpers ------------------------------------------------------------------------------------
+
+    def _supply_mismatch(self, fixed_rate: np.ndarray, outlet: np.ndarray, growth: np.ndarray) -> float:
+        """Make Eq. 25 solvable in every connected open region without an outlet, in place: there the sum of
+        the cells' fixed terms (storage + leak-off - sources) must vanish, since no flux leaves the region.
+        A prescribed width history (one-way coupling) need not satisfy it: a fracture engine whose cells take
+        negative widths beside a barrier stores fluid there that the proppant grid (w <= 0 closed) does not
+        see, so its open cells grow faster than the injection fills them. Left alone, the whole mismatch
+        would enter at the region's pinned cell as a spurious jet; instead it is spread over the region's
+        cells in proportion to their width growth ``growth`` (w - w^o, positive part). A region whose width
+        does not grow keeps the old rule (its pinned cell takes the round-off of a closed vessel, or a bed's
+        theta_f capped at close packing). Returns the spread mismatch [m^3/s], > 0 when the regions needed
+        more fluid than they got."""
+        labels = np.where(self.grid.active, self._labels, -1)
+        free = (labels >= 0) & ~np.isin(labels, np.unique(labels[outlet]))
+        if not free.any():
+            return 0.0
+        index = labels[free]
+        total = np.bincount(index, weights=fixed_rate[free])
+        weight = np.maximum(growth[free], 0.0)
+        grown = np.bincount(index, weights=weight, minlength=total.size)
+        total = np.where(grown > 0.0, total, 0.0)
+        share = np.divide(weight, grown[index], out=np.zeros_like(weight), where=grown[index] > 0.0)
+        fixed_rate[free] -= total[index] * share
+        return float(total.sum())
 
     def _pinned_cells(self, outlet: np.ndarray) -> np.ndarray:
         """One cell (the first in row-major order) of every open region that has no outlet cell."""
@@ -393,6 +438,7 @@ class _CorrectionSolver:
         self.rtol = rtol
         self.reuse_iterations = reuse_iterations
         self.lu = None
+        self.factorised = None  # the matrix whose factors ``lu`` holds (a checkpoint rebuilds lu from it)
         self.key = b""
         self.matrix = None
         self.fresh = False
@@ -418,10 +464,33 @@ class _CorrectionSolver:
                                               self.reuse_iterations)
             if converged:
                 return x
-        self.lu = splu(self.matrix, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+        self._factorise(self.matrix)
         self.fresh = True
         self.factorisations += 1
         return self.lu.solve(rhs)
+
+    def _factorise(self, matrix) -> None:
+        """LU factors of ``matrix`` (SuperLU, symmetric ordering; the same matrix gives the same factors)."""
+        self.lu = splu(matrix, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+        self.factorised = matrix
+
+    def state(self) -> dict:
+        """What later steps reuse (a checkpoint): the unknown-cell key and the CSC arrays of the matrix
+        factorised."""
+        state = {"key": np.frombuffer(self.key, dtype=np.uint8).copy()}
+        if self.factorised is not None:
+            m = self.factorised
+            state.update(data=m.data.copy(), indices=m.indices.copy(), indptr=m.indptr.copy(),
+                         shape=np.array(m.shape))
+        return state
+
+    def restore(self, state: dict) -> None:
+        """Back to a :meth:`state`: the same key and, refactorised from the same matrix, the same LU factors."""
+        self.key = np.asarray(state["key"], dtype=np.uint8).tobytes()
+        self.lu = self.factorised = None
+        if "data" in state:
+            self._factorise(sp.csc_matrix((state["data"], state["indices"], state["indptr"]),
+                                          shape=tuple(int(n) for n in state["shape"])))
 
 
 def _preconditioned_cg(matrix, rhs, precondition, limit, max_iterations):
@@ -446,6 +515,14 @@ def _preconditioned_cg(matrix, rhs, precondition, limit, max_iterations):
         rz, rz_old = np.sum(r * z), rz
         direction = z + (rz / rz_old) * direction
     return x, False
+
+
+def _momentum_force(momentum, width, axis, rho, area):
+    """A momentum source m [m^4/s^2 per unit density] on faces as the interphase-force term of the predictor's
+    drive w_f (-dp/dx - F) / rho (Eq. 26), so that dt w_f (-F / rho) = dt m / (dx dz): F = -rho m / (w_f dx dz)
+    on open faces, 0 on walls and closed faces (where the source cannot enter)."""
+    w_f = face_mean(width, width > 0.0, axis)
+    return np.divide(-rho * momentum, w_f * area, out=np.zeros_like(momentum), where=w_f > 0.0)
 
 
 def _imbalance(u, v, q_u, q_v, dx, dz):

@@ -133,6 +133,20 @@ class _Inlet:
     share: float
     owed: np.ndarray  # solid volume not yet emitted, per class [m^3]
     next_diameter: np.ndarray  # diameter of the next parcel, per class (NaN: not drawn yet)
+    jet: str = "none"  # direction of the entering slurry (Port.jet)
+    jet_area: float = math.inf  # cross-section normal to the jet [m^2]
+
+
+def jet_area(k: np.ndarray, i: np.ndarray, jet: str, frame: GridFrame, width: np.ndarray) -> float:
+    """Cross-section [m^2] an inlet's slurry enters through along ``jet``: over the grid lines normal to the
+    jet that the inlet covers (rows for an x-jet, columns for a z-jet), the sum of the mean width of its cells
+    on the line times the cell size across the jet (dz for an x-jet, dx for a z-jet); inf for "none"."""
+    if jet == "none":
+        return math.inf
+    line, across = (k, frame.dz) if jet[1] == "x" else (i, frame.dx)
+    _, index = np.unique(line, return_inverse=True)
+    mean = np.bincount(index, weights=width[k, i]) / np.bincount(index)
+    return float(np.sum(mean) * across)
 
 
 class Injector:
@@ -155,7 +169,8 @@ class Injector:
         self.rng = rng
         self.screened_out = 0.0  # solid volume held back at packed inlets [m^3]
         total = sum(p.share for p in ports)
-        self.inlets = [_Inlet(k, i, p.share / total, np.zeros(len(classes)), np.full(len(classes), np.nan))
+        self.inlets = [_Inlet(k, i, p.share / total, np.zeros(len(classes)), np.full(len(classes), np.nan),
+                              p.jet, jet_area(k, i, p.jet, frame, width))
                        for p, (k, i) in zip(ports, ports_to_cells(ports, frame, width, "geometry.inlets"))]
 
     def fluid_sources(self, t0: float, t1: float) -> np.ndarray:
@@ -168,6 +183,31 @@ class Injector:
         """Slurry volume rate per cell (nz, nx) [m^3/s] (fluid plus solids)."""
         return self._spread(self.rate(t0, t1))
 
+    def jet_speed(self, inlet: _Inlet, t0: float, t1: float) -> float:
+        """Speed [m/s] of an inlet's entering slurry: its share of the slurry rate over its jet cross-section
+        (0 for "none")."""
+        return self.rate(t0, t1) * inlet.share / inlet.jet_area
+
+    def jet_momentum(self, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray]:
+        """Momentum the entering fluid carries into the fluid's face control volumes per unit fluid density
+        [m^4/s^2] (the inlet source of the momentum balance, Eq. 8 / 26): on the downstream face of each cell of
+        a jet inlet (the face in the jet's direction) its fluid rate (1 - c) Q_cell times the jet speed, signed
+        along the axis; u faces (nz, nx+1), v faces (nz+1, nx). Zero for inlets without a jet."""
+        nz, nx = self.shape
+        mx, mz = np.zeros((nz, nx + 1)), np.zeros((nz + 1, nx))
+        fluid = 1.0 - sum(f for _, f in self.loadings(0.5 * (t0 + t1)))
+        for inlet in self.inlets:
+            if inlet.jet == "none":
+                continue
+            sign = 1.0 if inlet.jet[0] == "+" else -1.0
+            m = sign * fluid * self.rate(t0, t1) * inlet.share / inlet.k.size * self.jet_speed(inlet, t0, t1)
+            shift = 1 if sign > 0 else 0
+            if inlet.jet[1] == "x":
+                np.add.at(mx, (inlet.k, inlet.i + shift), m)
+            else:
+                np.add.at(mz, (inlet.k + shift, inlet.i), m)
+        return mx, mz
+
     def _spread(self, q: float) -> np.ndarray:
         out = np.zeros(self.shape)
         for inlet in self.inlets:
@@ -176,7 +216,8 @@ class Injector:
 
     def emit(self, t0: float, t1: float, room: np.ndarray | None = None,
              width: np.ndarray | None = None) -> dict[str, np.ndarray]:
-        """Parcels entering during (t0, t1], placed uniformly at random in their inlet's cells, at rest.
+        """Parcels entering during (t0, t1], placed uniformly at random in their inlet's cells, at rest (with the
+        jet speed for a jet inlet).
 
         ``room`` (nz, nx): solid volume each cell can still take [m^3] (None: unlimited), on the grid of
         ``width`` (the step's width); a parcel is placed only where its bilinear share (Eq. 37) fits the room of
@@ -199,7 +240,11 @@ class Injector:
                     if room is not None:
                         placed = self._fit(inlet, x, z, ppp * np.pi / 6.0 * d**3, room, mask)
                         x, z, d = x[placed], z[placed], d[placed]
-                    batches.append(make_batch(x, z, d, cls.density, ppp, c))
+                    batch = make_batch(x, z, d, cls.density, ppp, c)
+                    if inlet.jet != "none":  # the grains enter with the slurry's jet speed
+                        sign = 1.0 if inlet.jet[0] == "+" else -1.0
+                        batch["u" if inlet.jet[1] == "x" else "v"][:] = sign * self.jet_speed(inlet, t0, t1)
+                    batches.append(batch)
         return concat_batches(batches)
 
     def _fit(self, inlet: _Inlet, x: np.ndarray, z: np.ndarray, volume: np.ndarray, room: np.ndarray,

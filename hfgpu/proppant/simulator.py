@@ -10,7 +10,7 @@ particle sub-step; a step whose Courant number comes out above C_max is undone, 
 3. scatter: theta_p at the step's end, so that the fluid's storage term (theta_f w - theta_f^o w^o)/dt of
    Eq. 25 is the change over this very step;
 4. fluid SIMPLE step (Algorithm 1) with theta_f = 1 - theta_p, the interphase force F averaged over the
-   sub-loop, the inlets' fluid sources (1 - c) Q, leak-off and the outlets;
+   sub-loop, the inlets' fluid sources (1 - c) Q (and the momentum of jet inlets), leak-off and the outlets;
 5. a :class:`hfgpu.records.SolidBalanceRecord` goes to the sink; snapshots every ``output.every``.
 This is the cycle scatter -> fluid -> particles of the paper entered at the particles: each fluid step sees
 the force of the particle sub-loop over the same interval.
@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import json
 import math
 import warnings
 from dataclasses import dataclass
@@ -43,14 +44,14 @@ from ..errors import SimulationError
 from ..records import GridFrame, ProppantSnapshot, SolidBalanceRecord
 from .backend import get_backend
 from .config import Geometry, Port, ProppantSetup
-from .fluid import CourantLimitExceeded, FluidNumerics, FluidSolver
+from .fluid import CourantLimitExceeded, FluidNumerics, FluidSolver, FluidState
 from .grid import StaggeredGrid
 from .injection import Injector, batch_solid_volume, initial_suspension, ports_to_cells
 from .parcels import Parcels
 from .particle_ops_numpy import ParcelFluid, grid_fields
 
 #: fluid volumes [m^3] the fluid step reports (hfgpu.proppant.fluid.StepInfo), summed in fluid_totals
-FLUID_VOLUMES = ("injected", "opened", "stored", "leaked", "outflow", "dropped")
+FLUID_VOLUMES = ("injected", "opened", "supplied", "stored", "leaked", "outflow", "dropped")
 
 WidthField = Callable[[float], "tuple[np.ndarray, np.ndarray]"]
 
@@ -110,8 +111,9 @@ class ProppantSimulation:
     Attributes a caller may read: ``time``, ``grid``, ``parcels`` (:class:`Parcels`), ``fluid`` (the fluid
     solver's state), ``injected``, ``outflow``, ``screened_out`` [m^3] (solids), ``screen_out_time`` [s] (first
     hold-back, NaN when none), ``fluid_totals`` (the fluid volumes of FLUID_VOLUMES summed over the steps;
-    injected + opened = stored + leaked + outflow). ``add_parcels`` places extra parcels (counted as
-    injected), e.g. a single test particle.
+    injected + opened + supplied = stored + leaked + outflow; ``supplied``: what a width history
+    inconsistent with the injection needed beyond it, hfgpu.proppant.fluid.StepInfo). ``add_parcels`` places
+    extra parcels (counted as injected), e.g. a single test particle.
     """
 
     def __init__(self, scene, width_field: WidthField | None = None):
@@ -215,13 +217,14 @@ class ProppantSimulation:
                 self._inject(t0, t0 + dt)
             force = self._particle_subloop(dt, t0)
             self.moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
-            sources = (self.injector.fluid_sources(t0, t0 + dt) if self.injector is not None
-                       else np.zeros(self.grid.shape))
+            sources, momentum = ((self.injector.fluid_sources(t0, t0 + dt), self.injector.jet_momentum(t0, t0 + dt))
+                                 if self.injector is not None else (np.zeros(self.grid.shape), (None, None)))
             trial = self.solver.copy_state(self.fluid)
             try:
                 info = self.solver.step(trial, dt, self._fluid_theta_p(), force[0],
                                         force[1], sources=sources, leakoff=self.leakoff, outlets=self.outlets,
-                                        drag_x=force[2], drag_z=force[3])
+                                        drag_x=force[2], drag_z=force[3], momentum_x=momentum[0],
+                                        momentum_z=momentum[1])
             except CourantLimitExceeded as exc:
                 dt = min(0.5 * dt, exc.stable_dt)
                 continue
@@ -346,9 +349,13 @@ class ProppantSimulation:
                                   screened_out=self.screened_out)
 
     def run(self, sink, progress: Callable[[float], None] | None = None,
-            on_step: Callable[[StepInfo], None] | None = None) -> dict:
+            on_step: Callable[[StepInfo], None] | None = None, checkpoint=None, resume: dict | None = None) -> dict:
         """Step to the scene's end time, writing snapshots every ``output.every`` (and at 0 and the end) and
-        a balance record every step; returns a summary."""
+        a balance record every step; returns a summary.
+
+        Checkpoints (hfgpu.io.checkpoint): after the first step that ends at or past each interval,
+        ``checkpoint.save(time, state)`` gets {"simulation": :meth:`state`, "next_out", "max_residual"};
+        ``resume`` (such a state) continues from it, with the same steps as an uninterrupted run."""
         end = self.scene.run.end_time
         every = self.scene.output.every
         breaks = sorted(b for b in (self.scene.injection.schedule.breakpoints()
@@ -356,6 +363,9 @@ class ProppantSimulation:
         next_out = 0.0
         eps = 1e-9 * end
         max_residual = 0.0
+        if resume is not None:
+            self.restore(resume["simulation"])
+            next_out, max_residual = resume["next_out"], resume["max_residual"]
         while True:
             if self.time >= next_out - eps:
                 sink.proppant_snapshot(self.snapshot())
@@ -370,13 +380,59 @@ class ProppantSimulation:
                 on_step(info)
             if progress is not None:
                 progress(self.time)
+            if checkpoint is not None and checkpoint.due(self.time):
+                checkpoint.save(self.time, {"simulation": self.state(), "next_out": next_out,
+                                            "max_residual": max_residual})
         if abs(self.time - (next_out - every)) > eps:
             sink.proppant_snapshot(self.snapshot())
         record = self.balance()
         return dict(time=self.time, steps=self.steps, parcels=self.parcels.n, injected=record.injected,
                     in_domain=record.in_domain, outflow=record.outflow, screened_out=record.screened_out,
                     screen_out_time=self.screen_out_time,
-                    max_continuity_residual=max_residual, backend=self.numerics.backend)
+                    max_continuity_residual=max_residual, backend=self.numerics.backend,
+                    **{f"fluid_{name}": value for name, value in self.fluid_totals.items()})
+
+    # -- checkpoints ------------------------------------------------------------------------------------
+    #: Attributes (numbers or arrays) a checkpoint carries as they are: list every new persistent one here.
+    STATE_ATTRIBUTES = ("time", "steps", "safety", "injected", "outflow", "screen_out_time")
+
+    def state(self) -> dict:
+        """Everything needed to continue from now (a checkpoint): STATE_ATTRIBUTES, the fluid volumes, the parcels,
+        the fluid fields, the width and leak-off the grid holds, the pressure solver's reused LU factors (as the
+        matrix factorised), the random generator's state (numpy ``bit_generator.state``, as JSON) and the
+        inlets' owed volumes and next diameters."""
+        rng = self.injector.rng if self.injector is not None else self.rng  # a step retry deep-copies it
+        state = {**{name: getattr(self, name) for name in self.STATE_ATTRIBUTES},
+                 "fluid_totals": dict(self.fluid_totals), "parcels": self.parcels.as_dict(),
+                 "fluid": {f.name: getattr(self.fluid, f.name).copy() for f in dataclasses.fields(self.fluid)},
+                 "width": np.array(self.grid.width), "leakoff": self.leakoff.copy(),
+                 "linear": self.solver.linear.state(), "rng": json.dumps(rng.bit_generator.state)}
+        if self.injector is not None:
+            inlets = self.injector.inlets
+            state["injector"] = {"screened_out": self.injector.screened_out,
+                                 "owed": np.array([inlet.owed for inlet in inlets]),
+                                 "next_diameter": np.array([inlet.next_diameter for inlet in inlets])}
+        return state
+
+    def restore(self, state: dict) -> None:
+        """Continue from a :meth:`state` (of a simulation of the same scene, freshly built)."""
+        for name in self.STATE_ATTRIBUTES:
+            setattr(self, name, np.array(state[name]) if isinstance(state[name], np.ndarray) else state[name])
+        self.fluid_totals = {name: float(state["fluid_totals"][name]) for name in FLUID_VOLUMES}
+        self.parcels = Parcels(**{name: np.array(a) for name, a in state["parcels"].items()})
+        self.grid = self.grid.with_width(np.array(state["width"]))
+        self.leakoff = np.array(state["leakoff"])
+        self.solver.set_grid(self.grid)
+        self.solver.linear.restore(state["linear"])
+        self.fluid = FluidState(**{name: np.array(a) for name, a in state["fluid"].items()})
+        self.rng.bit_generator.state = json.loads(state["rng"])
+        if self.injector is not None:
+            self.injector.rng = self.rng
+            self.injector.screened_out = state["injector"]["screened_out"]
+            for inlet, owed, diameter in zip(self.injector.inlets, state["injector"]["owed"],
+                                             state["injector"]["next_diameter"]):
+                inlet.owed, inlet.next_diameter = np.array(owed), np.array(diameter)
+        self.moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
 
 
 def warn_screen_out(summary: dict, theta_cp: float, offset: float = 0.0) -> None:
@@ -390,15 +446,16 @@ def warn_screen_out(summary: dict, theta_cp: float, offset: float = 0.0) -> None
 
 
 def simulate(scene, sink, progress: Callable[[float], None] | None = None,
-             width_field: WidthField | None = None) -> dict:
+             width_field: WidthField | None = None, checkpoint=None, resume: dict | None = None) -> dict:
     """Run the MP-PIC proppant model of ``scene`` (physics "proppant") to its end time.
 
     ``sink`` receives ``proppant_snapshot`` and ``proppant_balance`` records (hfgpu.records); ``progress(t)``
     is called after every fluid step; ``width_field(t) -> (width, leakoff)`` optionally drives the width and
     leak-off fields (nz, nx) of the grid in time (coupling to a growing fracture). Returns a summary dict
     (time, steps, parcels, injected, in_domain, outflow, screened_out, screen_out_time (NaN when none),
-    max_continuity_residual, backend).
+    max_continuity_residual, backend). ``checkpoint``, ``resume``: see :meth:`ProppantSimulation.run`.
     """
-    summary = ProppantSimulation(scene, width_field=width_field).run(sink, progress)
+    summary = ProppantSimulation(scene, width_field=width_field).run(sink, progress, checkpoint=checkpoint,
+                                                                     resume=resume)
     warn_screen_out(summary, scene.proppant.params.theta_cp)
     return summary

@@ -67,8 +67,8 @@ def proppant_snapshot(t: float, n_parcels: int = 50, nz: int = 8, nx: int = 12) 
 
 
 def simulate_fracture(scene, sink, progress=None, steps: int = 40, snapshot_every: int = 10,
-                      fail_at: int | None = None):
-    """Fake fracture run: constant-rate injection, 80 % stored, snapshots every few steps."""
+                      fail_at: int | None = None, checkpoint=None, resume=None):
+    """Fake fracture run: constant-rate injection, 80 % stored, snapshots every few steps (no checkpoints)."""
     from hfgpu.errors import SimulationError
 
     dt = scene.run.end_time / steps
@@ -85,8 +85,9 @@ def simulate_fracture(scene, sink, progress=None, steps: int = 40, snapshot_ever
     return {"steps": steps, "note": "fake"}
 
 
-def simulate_proppant(scene, sink, progress=None, steps: int = 20, snapshot_every: int = 5):
-    """Fake proppant run: solids injected at a constant rate, 10 % leaving through the outlet."""
+def simulate_proppant(scene, sink, progress=None, steps: int = 20, snapshot_every: int = 5, checkpoint=None,
+                      resume=None):
+    """Fake proppant run: solids injected at a constant rate, 10 % leaving through the outlet (no checkpoints)."""
     dt = scene.run.end_time / steps
     for i in range(1, steps + 1):
         t = i * dt

@@ -42,7 +42,7 @@ def test_fracture_run_writes_results_and_prints_summary(tmp_path, monkeypatch, c
 
 
 def test_simulation_error_is_recorded_and_reraised(tmp_path, monkeypatch):
-    _fake(monkeypatch, "fracture", lambda scene, sink, progress=None:
+    _fake(monkeypatch, "fracture", lambda scene, sink, progress=None, **checkpoints:
           fakes.simulate_fracture(scene, sink, progress, fail_at=25))
     with pytest.raises(SimulationError, match="Newton"):
         run(load_scene(fakes.FRACTURE_SCENE), tmp_path / "r.h5", progress=False)

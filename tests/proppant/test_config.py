@@ -68,7 +68,12 @@ schedule = [{ until = "10 s", rate = "6 gpm", proppant = "sand", concentration =
     # REFERENCE.md section 5: 1.5 ppg of 2550 kg/m^3 sand -> slurry fraction 0.065845
     assert scene.injection.schedule.proppant_fraction(1.0) == ("sand", pytest.approx(0.065845, abs=2e-6))
     inlet = scene.proppant.geometry.inlets[0]
-    assert inlet.kind == "segment" and inlet.depth_end == pytest.approx(0.12)
+    assert inlet.kind == "segment" and inlet.depth_end == pytest.approx(0.12) and inlet.jet == "none"
+    jet = load_scene(text.replace('depth_end = "12 cm"', 'depth_end = "12 cm"\njet = "+x"'))
+    assert jet.proppant.geometry.inlets[0].jet == "+x"
+    with pytest.raises(SceneError) as err:
+        load_scene(text.replace('depth_end = "12 cm"', 'depth_end = "12 cm"\njet = "x"'))
+    assert err.value.path == "geometry.inlets[0].jet" and "'+x'" in str(err.value)
 
 
 @pytest.mark.parametrize("old, new, path", [

@@ -333,3 +333,61 @@ def test_grid_faces_and_volumes():
     np.testing.assert_allclose(grid.volume_u, 0.02 * grid.width_u)
     assert grid.cell_volume.sum() == pytest.approx(0.02 * width.sum())
     assert grid.with_width(width * 2).width_u[1, 1] == pytest.approx(7e-3)
+
+
+def test_jet_momentum_replaces_the_pressure_it_would_take():
+    """Momentum balance of the jet's face (Eq. 26): a source carrying momentum flux rho Q U into a channel
+    leaves the velocities of a straight one-row channel unchanged (continuity fixes them) and lowers the
+    pressure drop across the jet's face by exactly rho Q U / (w_f dz), the jet's thrust over the face area."""
+    grid = StaggeredGrid.slot(1.0, 0.05, 2e-3, nx=20, nz=1)
+    rate, jet_speed = 1e-5, 0.3
+    sources = np.zeros(grid.shape)
+    sources[0, 0] = rate
+    outlets = np.zeros(grid.shape, dtype=bool)
+    outlets[0, -1] = True
+    momentum = np.zeros((1, 21))
+    momentum[0, 1] = rate * jet_speed
+    results = []
+    for m in (None, momentum):
+        solver = FluidSolver(grid, RHO, MU)
+        state = solver.initial_state()
+        for _ in range(5):
+            solver.step(state, 0.05, sources=sources, outlets=outlets, momentum_x=m)
+        results.append(state)
+    plain, jet = results
+    np.testing.assert_allclose(jet.u, plain.u, rtol=1e-10, atol=1e-15)
+    drop = lambda s: s.p[0, 0] - s.p[0, 1]  # noqa: E731
+    thrust = RHO * rate * jet_speed / (2e-3 * grid.frame.dz)
+    assert drop(plain) - drop(jet) == pytest.approx(thrust, rel=1e-8)
+    np.testing.assert_allclose(np.diff(jet.p[0, 1:]), np.diff(plain.p[0, 1:]), rtol=1e-8)
+
+
+def test_width_history_inconsistent_with_the_injection_is_spread_not_jetted():
+    """A closed region whose prescribed width grows faster than its sources fill it (a one-way coupled width
+    history that is not mass-consistent): the missing fluid is supplied in proportion to each cell's growth
+    (StepInfo.supplied = growth volume - injected volume, exactly), so a uniformly growing slot stays at rest
+    instead of jetting the whole deficit out of its pinned cell; the balance injected + opened + supplied =
+    stored + leaked + outflow holds."""
+    w0, rate = 1e-3, 1e-5  # growth [m/s]
+    grid = StaggeredGrid.slot(1.0, 0.5, w0, nx=20, nz=10)
+    solver = FluidSolver(grid, RHO, MU)
+    state = solver.initial_state()
+    dt, t = 0.05, 0.0
+    for _ in range(5):
+        t += dt
+        solver.set_grid(grid.with_width(np.full(grid.shape, w0 + rate * t)))
+        info = solver.step(state, dt)
+    assert max(np.abs(state.u).max(), np.abs(state.v).max()) < 1e-12
+    assert info.supplied == pytest.approx(rate * dt * 0.5, rel=1e-10)
+    # with a source of half the growth at the centre: the other half is supplied, the flow is the source's
+    sources = np.zeros(grid.shape)
+    sources[5, 10] = 0.5 * rate * 0.5
+    for _ in range(5):
+        t += dt
+        solver.set_grid(grid.with_width(np.full(grid.shape, w0 + rate * t)))
+        info = solver.step(state, dt, sources=sources)
+        balance = info.injected + info.opened + info.supplied - info.stored - info.leaked - info.outflow
+        assert abs(balance) < 1e-12 * info.stored
+    assert info.supplied == pytest.approx(0.5 * rate * dt * 0.5, rel=1e-10)
+    corner = max(abs(state.u[0, 1]), abs(state.v[1, 0]))
+    assert corner < 0.05 * max(np.abs(state.u).max(), np.abs(state.v).max())

@@ -135,3 +135,28 @@ def test_a_zero_length_step_is_a_clear_error():
     sim = ProppantSimulation(scene)
     with pytest.raises(SimulationError, match="zero-length time step"):
         sim.step(limit=0.0)
+
+
+def test_jet_inlet_momentum_and_parcel_speed():
+    """A jet inlet (Port.jet): the slurry enters at Q_inlet / A (A = its cells' width x dz for an x-jet); the
+    fluid carries (1 - c) Q_cell U into the face downstream of each of its cells; the grains start at U."""
+    q, c = 3.79e-4, 0.065845
+    ports = (Port("segment", x=0.0, depth=0.07, x_end=0.0, depth_end=0.095, jet="+x"),  # cells 7, 8, 9
+             Port("point", x=0.2, depth=0.1, jet="-z"), Port("point", x=0.3, depth=0.1))
+    inj = Injector(ports, FRAME, WIDTH, (SAND,), [20.0], rate=lambda t0, t1: q,
+                   loadings=lambda t: [(0, c)], rng=np.random.default_rng(5))
+    speed = q / 3 / (3 * FRAME.dz * 5e-3)
+    mx, mz = inj.jet_momentum(0.0, 0.1)
+    assert mx.shape == (20, 41) and mz.shape == (21, 40)
+    np.testing.assert_allclose(mx[7:10, 1], (1 - c) * q / 3 / 3 * speed, rtol=1e-13)
+    assert np.count_nonzero(mx) == 3
+    point_speed = q / 3 / (FRAME.dx * 5e-3)
+    assert mz[10, 20] == pytest.approx(-(1 - c) * q / 3 * point_speed, rel=1e-13)  # -z: the cell's upper face
+    assert np.count_nonzero(mz) == 1  # the third inlet has no jet
+    batch = inj.emit(0.0, 0.5)
+    left, point = batch["x"] < 0.01, np.abs(batch["x"] - 0.2) < 0.01
+    assert left.any() and point.any()
+    np.testing.assert_allclose(batch["u"][left], speed, rtol=1e-13)
+    np.testing.assert_allclose(batch["v"][point], -point_speed, rtol=1e-13)
+    rest = ~left & ~point
+    assert np.all(batch["u"][rest] == 0.0) and np.all(batch["v"][~point] == 0.0)

@@ -1,0 +1,114 @@
+"""Limits checked before a run does any work: scenes the engines cannot run are refused with a SceneError that
+names the key, the value and the allowed range (``check_limits(scene)``, called by :func:`hfgpu.runner.run`).
+
+Only real limits are here, each with its reason (docs/stability.md has the matrix that found them):
+
+* slurry denser than close packing: a stage's proppant volume fraction (and the initial suspension) must not
+  exceed theta_cp, the close-packing fraction at which the interparticle stress of the paper's Eq. 16 diverges
+  and the slurry viscosity of Eq. 10 is singular: no fluid can carry such a slurry;
+* parcel memory: the MP-PIC state holds every parcel in memory (plus per-step work arrays); a scene whose
+  initial suspension and scheduled proppant would make more parcels than fit in the machine's memory is
+  refused up front instead of failing hours in.
+
+What the engines already refuse themselves (not repeated here): a first stage with rate 0, a starting fracture
+that needs longer than the first stage to form (``fracture.initial_radius_cells``), c_max outside (0, 1).
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from .errors import SceneError
+
+#: Host memory one parcel costs during a run [bytes]: its 9 state arrays (7 float64, 2 int32: 64 B), the
+#: step's saved copy, the gathered fluid and the bilinear weights of the particle kernels, the snapshot copy.
+#: Measured: 434 B (peak resident memory of a 1.02e6-parcel Taichi run less a 1e4-parcel one, per parcel,
+#: docs/stability.md); about twice that leaves room for the copies made when parcels are appended.
+BYTES_PER_PARCEL = 1024
+
+
+def physical_memory() -> int:
+    """This machine's physical memory [bytes] (os.sysconf), or 0 where it cannot be read."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return 0
+
+
+def check_limits(scene, memory: int | None = None) -> None:
+    """Raise :class:`SceneError` for a scene beyond the limits above; ``memory`` [bytes] defaults to
+    :func:`physical_memory`."""
+    if scene.proppant is None:
+        return
+    _check_packing(scene)
+    _check_parcel_memory(scene, physical_memory() if memory is None else memory)
+
+
+def _check_packing(scene) -> None:
+    """Slurry and initial suspension volume fractions <= theta_cp (Eq. 10, 16 diverge there)."""
+    theta_cp = scene.proppant.params.theta_cp
+    allowed = (f"at most theta_cp = {theta_cp:g} (mppic.theta_cp): a slurry denser than close packing cannot "
+               "flow (Eq. 10 and 16 of the paper diverge at theta_cp)")
+    if scene.injection is not None:
+        for i, stage in enumerate(scene.injection.schedule.stages):
+            for key in ("volume_fraction", "end_volume_fraction"):
+                value = getattr(stage, key)
+                if value > theta_cp:
+                    raise SceneError(f"injection.schedule[{i}].{key}", value, allowed)
+    total = sum(c.initial_volume_fraction for c in scene.proppant.classes)
+    if total > theta_cp:
+        raise SceneError("proppant[*].initial_volume_fraction", total, f"their sum must be {allowed}")
+
+
+def estimated_parcels(scene) -> float | None:
+    """Parcels the scene will create: its initial suspension plus the scheduled proppant over parcels of
+    ``particles_per_parcel`` particles (hfgpu.proppant.simulator.particles_per_parcel); None for a coupled
+    scene without a fixed ``particles_per_parcel`` (its grid is known only once the fracture has run)."""
+    from .proppant.simulator import build_grid, particles_per_parcel
+
+    setup = scene.proppant
+    schedule = scene.injection.schedule if scene.injection is not None else None
+    if setup.geometry.kind == "fracture":
+        if setup.numerics.particles_per_parcel is None:
+            return None
+        cell_volumes = np.zeros(0)
+        ppp = [setup.numerics.particles_per_parcel] * len(setup.classes)
+    else:
+        grid = build_grid(setup.geometry, scene.mesh)
+        cell_volumes = grid.cell_volume[grid.active]
+        ppp = particles_per_parcel(setup, schedule, float(np.median(cell_volumes)))
+    total = 0.0
+    for c, cls in enumerate(setup.classes):
+        parcel = ppp[c] * cls.size.mean_particle_volume()
+        if cls.initial_volume_fraction > 0.0:
+            total += float(np.sum(np.maximum(1.0, np.rint(cls.initial_volume_fraction * cell_volumes / parcel))))
+        start = 0.0
+        for stage in (schedule.stages if schedule is not None else ()):
+            if stage.proppant == cls.name:
+                mean_fraction = 0.5 * (stage.volume_fraction + stage.end_volume_fraction)
+                total += stage.rate * (stage.until - start) * mean_fraction / parcel
+            start = stage.until
+    return total
+
+
+def _check_parcel_memory(scene, memory: int) -> None:
+    """Estimated parcels x BYTES_PER_PARCEL must fit in ``memory``."""
+    if memory <= 0:
+        return
+    count = estimated_parcels(scene)
+    if count is None:
+        return
+    most = memory / BYTES_PER_PARCEL
+    if count <= most:
+        return
+    numerics = scene.proppant.numerics
+    if numerics.particles_per_parcel is not None:
+        key, value = "mppic.particles_per_parcel", numerics.particles_per_parcel
+    else:
+        key, value = "mppic.parcels_per_cell", numerics.parcels_per_cell
+    change = "raise it" if key.endswith("particles_per_parcel") else "lower it"
+    raise SceneError(key, value, f"this scene would make ~{count:.3g} parcels; at most {most:.3g} fit in this "
+                     f"machine's {memory / 2**30:.3g} GiB ({BYTES_PER_PARCEL} bytes per parcel): {change} by a "
+                     f"factor of at least {count / most:.3g}")
