@@ -68,20 +68,10 @@ class Knobs:
 #: The knobs a preset sets.
 PRESET_KNOBS = ("refinement", "time_step_relaxation", "newton_tolerance", "simple_tolerance", "parcels_per_cell",
                 "particle_substeps", "c_max", "dt_max")
-#: Issue 5's table of presets, used where hfgpu has no ``hfgpu.presets``; "balanced" equals the engine's defaults.
-ISSUE_PRESETS = {
-    "fast": Knobs(0.5, 1.0, 1e-4, 1e-4, 4, 2, 0.8, 0.1),
-    "balanced": Knobs(1.0, 0.5, 1e-6, 1e-5, 16, 4, 0.5, 0.05),
-    "accurate": Knobs(2.0, 0.25, 1e-8, 1e-6, 32, 8, 0.3, 0.02),
-}
-
-
 def package_presets() -> dict[str, Knobs]:
-    """The presets of ``hfgpu.presets`` as Knobs (applied through the knobs here), else :data:`ISSUE_PRESETS`."""
-    try:
-        from hfgpu.presets import PRESETS as package
-    except ImportError:
-        return dict(ISSUE_PRESETS)
+    """The presets of :mod:`hfgpu.presets` as Knobs (the study applies them through the knobs)."""
+    from hfgpu.presets import PRESETS as package
+
     return {name: Knobs(**{k: getattr(p, k) for k in PRESET_KNOBS}) for name, p in package.items()}
 
 
