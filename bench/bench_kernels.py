@@ -1,13 +1,15 @@
 """Parcel updates per second of the MP-PIC particle operations, Taichi vs the NumPy reference.
 
-    python bench/bench_kernels.py [--sizes 1e4 1e5 1e6] [--arch cpu] [--repeats 5]
+    python bench/bench_kernels.py [--sizes 1e4 1e5 1e6] [--arch cpu] [--repeats 5] [--threads 2] [--profile]
 
 Grid 200 x 100 cells (nx x nz), a random open/closed width field, random parcels in open cells, random fluid.
 Columns: M parcel-updates/s (best of ``repeats`` timed calls after one warm-up call: the machine may be shared)
 for scatter of parcels in random order, and, on parcels sorted by cell (Parcels.sort_by_cell, as a simulator
 does every few steps), scatter, gather, push, gather + push, exchange, the whole particle step (scatter, grid
 fields, gather, push, exchange), and the re-sort of nearly sorted parcels; speed-up of Taichi over NumPy.
-Prints a table; asserts nothing.
+Prints a table per size; asserts nothing. ``--profile``: before each table, the Taichi kernel profiler's table
+(min / avg / max time per kernel: kernel time only, without Python, launch and ndarray overhead).
+``--threads``: Taichi CPU threads (default all cores).
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import time
 
 import numpy as np
 
+from hfgpu.kernels.runtime import init, ti
 from hfgpu.proppant.backend import get_backend, grid_fields
 from hfgpu.proppant.params import MppicParams
 from hfgpu.proppant.parcels import Parcels
@@ -92,17 +95,25 @@ def main() -> None:
     ap.add_argument("--arch", default=None, help="Taichi arch (default HFGPU_ARCH or cpu)")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--skip-numpy-above", type=float, default=1e7)
+    ap.add_argument("--threads", type=int, default=None)
+    ap.add_argument("--profile", action="store_true")
     args = ap.parse_args()
+    init(args.arch, kernel_profiler=args.profile, cpu_threads=args.threads)
     ti_backend = get_backend("taichi", arch=args.arch)
     np_backend = get_backend("numpy")
     print(f"grid {NX} x {NZ}, Taichi arch {ti_backend.arch}; M parcel-updates/s (best of {args.repeats})")
     head = f"{'parcels':>9} | {'op':<22} | {'taichi':>9} | {'numpy':>9} | {'speed-up':>8}"
-    print(head)
-    print("-" * len(head))
     for size in args.sizes:
         n = int(size)
+        if args.profile:
+            ti.profiler.clear_kernel_profiler_info()
         t_ti = measure(ti_backend, n, args.repeats)
+        if args.profile:
+            print(f"Taichi kernel profiler, {n} parcels (min: the fastest call, kernel time only)")
+            ti.profiler.print_kernel_profiler_info()
         t_np = measure(np_backend, n, max(1, args.repeats // 2)) if n <= args.skip_numpy_above else None
+        print(head)
+        print("-" * len(head))
         for op, seconds in t_ti.items():
             rate = n / seconds / 1e6
             if t_np is None:

@@ -2,13 +2,21 @@
 ``hfgpu.proppant.particle_ops_numpy`` (same formulas, same order of operations up to round-off; tests compare
 them).
 
-Gather: one thread per parcel. Push: one task per LANES consecutive parcels; their drag solves (Eq. 43) run
-as LANES-wide vectors so that the independent dependency chains of the parcels interleave (one parcel's
-fixed-point iteration is a serial chain of log, exp, sqrt and divisions, latency-bound), then each parcel
-moves (Eq. 44, walls). Parcel positions enter the stencils as cell coordinates s = (x - x0) / dx, computed
-once per parcel and position (the same expression as ``interpolation.weights``). The push's powers
-theta_f^-2.65, theta_f^-1.78 and Re^0.687, Re^(2/3) are exp(a log b) with log theta_f shared: float64 ``pow``
-is about twice the cost of exp + log, and these libm calls bound the push.
+Gather: one thread per parcel. Push: one task per LANES (16) consecutive parcels; their drag solves (Eq. 43)
+run as LANES-wide vectors so that the independent dependency chains of the parcels interleave (one parcel's
+fixed-point iteration is a serial chain of sqrt, log, exp and a division); then bed friction, bridging and
+the move (Eq. 44, walls) parcel by parcel. The powers theta_f^-2.65, theta_f^-1.78 and Re^0.687, Re^(2/3) are
+exp(a log b) with the inline exp and log of ``elementary`` (no libm call, so LLVM vectorises them across the
+lanes; libm calls were a third of the push), log theta_f shared. Parcel positions enter the stencils as cell
+coordinates s = (x - x0) / dx (the same expression as ``interpolation.weights``).
+
+Fast paths (per-cell bits of stencil_flags, which the backend computes for each push, and for the other
+kernels once per width field): a parcel whose cell and its 8 neighbours are open and inside the grid
+(INTERIOR) uses plain bilinear weights without mask reads (gather, scatter, exchange); one whose 3 x 3 cells
+are also below close packing (QUIET) and that stays in its cell skips the wall checks of its move; one in a
+LOOSE cell is not on a bed. Each gives what the general path gives (up to round-off: the renormalisation by a
+sum of weights that is 1 up to an ulp). The gather reads its node fields as flat arrays, one index per
+stencil.
 
 Scatter and exchange: the parcels are split into ``blocks`` ranges, one task each, which sum runs of parcels
 sharing a stencil in registers and add them to the grid copy ``out[copy]``. On the CPU (``private`` true)
@@ -20,12 +28,14 @@ All arrays are numpy arrays passed as ``ti.types.ndarray`` (zero copy on the CPU
 device on a GPU, once per call).
 """
 
+from hfgpu.kernels import elementary
 from hfgpu.kernels.runtime import ti
 
 F1 = ti.types.ndarray(dtype=ti.f64, ndim=1)
 F2 = ti.types.ndarray(dtype=ti.f64, ndim=2)
 F4 = ti.types.ndarray(dtype=ti.f64, ndim=4)
 I1 = ti.types.ndarray(dtype=ti.i32, ndim=1)
+I2 = ti.types.ndarray(dtype=ti.i32, ndim=2)
 
 PI = 3.141592653589793
 CHUNK = 64  # parcels per block of the atomic (GPU) deposits
@@ -34,43 +44,111 @@ SEEN = 11  # what a parcel sees, in the order of ParcelFluid: u_f, v_f, dp/dx, d
 
 
 @ti.func
-def bilinear(sx: ti.f64, sz: ti.f64, mask: ti.template()):
+def bilinear(sx: ti.f64, sz: ti.f64, mask: ti.template(), interior: ti.template()):
     """Renormalised bilinear weights (Eq. 36-37) onto the active 2 x 2 nodes of ``mask`` at node coordinates
-    (sx, sz) = ((x - x0) / dx - ox, (z - z0) / dz - oz); see proppant/interpolation.py."""
+    (sx, sz) = ((x - x0) / dx - ox, (z - z0) / dz - oz); see proppant/interpolation.py. ``interior``: the
+    parcel's cell is INTERIOR (stencil_flags), so all 4 nodes are in the grid and active and the plain weights
+    (summing to 1 up to round-off) are used."""
     fi = ti.floor(sx)
     fk = ti.floor(sz)
     fx = sx - fi
     fz = sz - fk
     i0 = ti.cast(fi, ti.i32)
     k0 = ti.cast(fk, ti.i32)
-    nz = mask.shape[0]
-    nx = mask.shape[1]
     w = ti.Vector([(1 - fz) * (1 - fx), (1 - fz) * fx, fz * (1 - fx), fz * fx], dt=ti.f64)
-    for a in ti.static(range(2)):
-        for b in ti.static(range(2)):
-            kk = k0 + a
-            ii = i0 + b
-            if kk >= 0 and kk < nz and ii >= 0 and ii < nx:
-                w[2 * a + b] = w[2 * a + b] * mask[kk, ii]
-            else:
-                w[2 * a + b] = 0.0
-    total = w[0] + w[1] + w[2] + w[3]
-    if total > 0.0:
-        w = w / total
-    else:
-        w = ti.Vector([0.0, 0.0, 0.0, 0.0], dt=ti.f64)
+    if ti.static(not interior):
+        nz = mask.shape[0]
+        nx = mask.shape[1]
+        for a in ti.static(range(2)):
+            for b in ti.static(range(2)):
+                kk = k0 + a
+                ii = i0 + b
+                if kk >= 0 and kk < nz and ii >= 0 and ii < nx:
+                    w[2 * a + b] = w[2 * a + b] * mask[kk, ii]
+                else:
+                    w[2 * a + b] = 0.0
+        total = w[0] + w[1] + w[2] + w[3]
+        if total > 0.0:
+            w = w / total
+        else:
+            w = ti.Vector([0.0, 0.0, 0.0, 0.0], dt=ti.f64)
     return k0, i0, w
 
 
 @ti.func
-def sample(field: ti.template(), k0: ti.i32, i0: ti.i32, w):
-    """Sum of node values x weights (Eq. 40-41); nodes of weight 0 are not read."""
+def sample(field: ti.template(), base: ti.i32, stride: ti.i32, w, interior: ti.template()):
+    """Sum of node values x weights (Eq. 40-41) of a field given flat (row-major, ``stride`` nodes per row),
+    stencil node [0, 0] at flat index base; outside INTERIOR cells nodes of weight 0 are not read."""
     s = 0.0
     for a in ti.static(range(2)):
         for b in ti.static(range(2)):
-            if w[2 * a + b] > 0.0:
-                s += field[k0 + a, i0 + b] * w[2 * a + b]
+            if ti.static(interior):
+                s += field[base + a * stride + b] * w[2 * a + b]
+            elif w[2 * a + b] > 0.0:
+                s += field[base + a * stride + b] * w[2 * a + b]
     return s
+
+
+INTERIOR = 1  # stencil_flags: the cell and its 8 neighbours lie in the grid and are open
+QUIET = 2  # ... and none of them has theta_p >= theta_cp
+LOOSE = 4  # ... and the cell and the one below it (+z) have theta_p < friction_volume_fraction
+
+
+@ti.kernel
+def stencil_flags(width: F2, theta: F2, theta_cp: ti.f64, dense: ti.f64, flags: I2):
+    """Per cell the bits INTERIOR, QUIET and LOOSE (see the constants; the last two only with INTERIOR): a
+    parcel owned by an INTERIOR cell has all its stencil nodes active (bilinear's plain weights); one owned by
+    a QUIET cell that stays in it is not stopped by any rule of blocked(); one owned by a LOOSE cell is not on
+    a bed (on_bed)."""
+    nz = width.shape[0]
+    nx = width.shape[1]
+    for k in range(nz):
+        for i in range(nx):
+            flags[k, i] = cell_flags(k, i, nz, nx, width, theta, theta_cp, dense)
+
+
+@ti.func
+def cell_flags(k: ti.i32, i: ti.i32, nz: ti.i32, nx: ti.i32, width: ti.template(), theta: ti.template(),
+               theta_cp: ti.f64, dense: ti.f64) -> ti.i32:
+    """stencil_flags of cell (k, i)."""
+    f = 0
+    if k >= 1 and k < nz - 1 and i >= 1 and i < nx - 1:
+        f = INTERIOR | QUIET
+        for a in ti.static(range(3)):
+            for b in ti.static(range(3)):
+                if width[k + a - 1, i + b - 1] <= 0.0:
+                    f = 0
+                elif theta[k + a - 1, i + b - 1] >= theta_cp:
+                    f = f & ~QUIET
+        if f != 0 and theta[k, i] < dense and theta[k + 1, i] < dense:
+            f = f | LOOSE
+    return f
+
+
+@ti.func
+def deposit_weights(sx: ti.f64, sz: ti.f64, ox: ti.template(), oz: ti.template(), mask: ti.template(),
+                    flags: ti.template()):
+    """bilinear at (sx + ox, sz + oz) onto ``mask`` for a parcel at cell coordinates (sx, sz): plain weights
+    where its cell is INTERIOR."""
+    k0 = ti.cast(0, ti.i32)
+    i0 = ti.cast(0, ti.i32)
+    w = ti.Vector.zero(ti.f64, 4)
+    if owner_flags(sx, sz, flags) & INTERIOR:
+        k0, i0, w = bilinear(sx + ox, sz + oz, mask, True)
+    else:
+        k0, i0, w = bilinear(sx + ox, sz + oz, mask, False)
+    return k0, i0, w
+
+
+@ti.func
+def owner_flags(sx: ti.f64, sz: ti.f64, flags: ti.template()) -> ti.i32:
+    """stencil_flags of the cell containing the point of cell coordinates (sx, sz); 0 outside the grid."""
+    i = ti.cast(ti.floor(sx + 0.5), ti.i32)
+    k = ti.cast(ti.floor(sz + 0.5), ti.i32)
+    f = 0
+    if k >= 0 and k < flags.shape[0] and i >= 0 and i < flags.shape[1]:
+        f = flags[k, i]
+    return f
 
 
 @ti.func
@@ -147,8 +225,8 @@ def packed_gain(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cell_mask: ti.
                 theta_cp: ti.f64) -> ti.i32:
     """Whether the move raises the parcel's bilinear weight on a cell with theta_p >= theta_cp."""
     out = 0
-    k0, i0, w0 = bilinear(sx, sz, cell_mask)
-    k1, i1, w1 = bilinear(sxn, szn, cell_mask)
+    k0, i0, w0 = bilinear(sx, sz, cell_mask, False)
+    k1, i1, w1 = bilinear(sxn, szn, cell_mask, False)
     for a in ti.static(range(2)):
         for b in ti.static(range(2)):
             if w1[2 * a + b] > 0.0:
@@ -195,7 +273,7 @@ def block_range(block: ti.i32, blocks: ti.i32, n: ti.i32, private: ti.template()
 
 @ti.kernel
 def moment_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles: F1,
-                x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, cell_mask: F2, blocks: ti.i32,
+                x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, cell_mask: F2, flags: I2, blocks: ti.i32,
                 private: ti.template(), out: F4):
     """Bilinear sums of volume, mass, mass u, mass v, mass |u|^2, n r^3, n r^2 (Eq. 38) into out (copies, nz,
     nx, 7) (channel last: a node's sums share a cache line), which the caller zeroes and sums over copies.
@@ -210,7 +288,7 @@ def moment_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles: 
         kb = -1
         ib = -1
         for p in range(start, end):
-            k0, i0, w = bilinear((x[p] - x0) / dx, (z[p] - z0) / dz, cell_mask)
+            k0, i0, w = deposit_weights((x[p] - x0) / dx, (z[p] - z0) / dz, 0.0, 0.0, cell_mask, flags)
             if k0 != kb or i0 != ib:
                 if kb != -1 or ib != -1:
                     flush(out, copy, kb, ib, acc, 7, private)
@@ -230,44 +308,74 @@ def moment_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles: 
 
 
 @ti.func
-def seen_at(sx: ti.f64, sz: ti.f64, cell_mask: ti.template(), xface_mask: ti.template(),
+def seen_at(sx: ti.f64, sz: ti.f64, interior: ti.template(), cell_mask: ti.template(), xface_mask: ti.template(),
             zface_mask: ti.template(), fluid_u: ti.template(), fluid_v: ti.template(), dpdx: ti.template(),
             dpdz: ti.template(), dtaudx: ti.template(), dtaudz: ti.template(), theta: ti.template(),
             mean_u: ti.template(), mean_v: ti.template(), damping: ti.template(), width: ti.template()):
     """The SEEN grid values at cell coordinates (sx, sz) (Eq. 40-41 with x-/z-face weights; cell fields with
-    cell weights; the width of the own cell)."""
-    kx, ix, wx = bilinear(sx + 0.5, sz, xface_mask)
-    kz, iz, wz = bilinear(sx, sz + 0.5, zface_mask)
-    kc, ic, wc = bilinear(sx, sz, cell_mask)
-    return ti.Vector([sample(fluid_u, kx, ix, wx), sample(fluid_v, kz, iz, wz),
-                      sample(dpdx, kx, ix, wx), sample(dpdz, kz, iz, wz),
-                      sample(dtaudx, kx, ix, wx), sample(dtaudz, kz, iz, wz),
-                      sample(theta, kc, ic, wc), sample(mean_u, kc, ic, wc), sample(mean_v, kc, ic, wc),
-                      sample(damping, kc, ic, wc), owner_width(sx, sz, width)], dt=ti.f64)
+    cell weights; the width of the own cell); ``interior``: the own cell is INTERIOR (bilinear). The masks are
+    2-D, the fields flat (row-major) views of the (nz, nx+1), (nz+1, nx) and (nz, nx) node sets."""
+    nx = cell_mask.shape[1]
+    kx, ix, wx = bilinear(sx + 0.5, sz, xface_mask, interior)
+    kz, iz, wz = bilinear(sx, sz + 0.5, zface_mask, interior)
+    kc, ic, wc = bilinear(sx, sz, cell_mask, interior)
+    bx = kx * (nx + 1) + ix
+    bz = kz * nx + iz
+    bc = kc * nx + ic
+    i = ti.cast(ti.floor(sx + 0.5), ti.i32)
+    k = ti.cast(ti.floor(sz + 0.5), ti.i32)
+    own = 0.0
+    if k >= 0 and k < cell_mask.shape[0] and i >= 0 and i < nx:
+        own = width[k * nx + i]
+    return ti.Vector([sample(fluid_u, bx, nx + 1, wx, interior), sample(fluid_v, bz, nx, wz, interior),
+                      sample(dpdx, bx, nx + 1, wx, interior), sample(dpdz, bz, nx, wz, interior),
+                      sample(dtaudx, bx, nx + 1, wx, interior), sample(dtaudz, bz, nx, wz, interior),
+                      sample(theta, bc, nx, wc, interior), sample(mean_u, bc, nx, wc, interior),
+                      sample(mean_v, bc, nx, wc, interior), sample(damping, bc, nx, wc, interior), own],
+                     dt=ti.f64)
 
 
 @ti.kernel
-def gather(x: F1, z: F1, x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64,
+def gather(x: F1, z: F1, x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, flags: I2,
            cell_mask: F2, xface_mask: F2, zface_mask: F2,
-           fluid_u: F2, fluid_v: F2, dpdx: F2, dpdz: F2, dtaudx: F2, dtaudz: F2,
-           theta: F2, mean_u: F2, mean_v: F2, damping: F2, width: F2, seen: F2):
-    """Grid fields at the parcels (Eq. 40-41) into seen (SEEN, n), rows in the order of ParcelFluid."""
-    for p in x:
-        s = seen_at((x[p] - x0) / dx, (z[p] - z0) / dz, cell_mask, xface_mask, zface_mask, fluid_u, fluid_v,
-                    dpdx, dpdz, dtaudx, dtaudz, theta, mean_u, mean_v, damping, width)
+           fluid_u: F1, fluid_v: F1, dpdx: F1, dpdz: F1, dtaudx: F1, dtaudz: F1,
+           theta: F1, mean_u: F1, mean_v: F1, damping: F1, width: F1, seen: F2):
+    """Grid fields at the parcels (Eq. 40-41) into seen (SEEN, n), rows in the order of ParcelFluid; flags of
+    stencil_flags; the fields flat (seen_at)."""
+    for p in range(x.shape[0]):
+        sx = (x[p] - x0) / dx
+        sz = (z[p] - z0) / dz
+        s = ti.Vector.zero(ti.f64, SEEN)
+        if owner_flags(sx, sz, flags) & INTERIOR:
+            s = seen_at(sx, sz, True, cell_mask, xface_mask, zface_mask, fluid_u, fluid_v, dpdx, dpdz, dtaudx,
+                        dtaudz, theta, mean_u, mean_v, damping, width)
+        else:
+            s = seen_at(sx, sz, False, cell_mask, xface_mask, zface_mask, fluid_u, fluid_v, dpdx, dpdz, dtaudx,
+                        dtaudz, theta, mean_u, mean_v, damping, width)
         for j in ti.static(range(SEEN)):
             seen[j, p] = s[j]
 
 
-LANES = 4  # parcels per push task: their independent drag solves interleave (the solve is latency-bound)
+LANES = 16  # parcels per push task: their drag solves interleave (8: 1.2x slower; compiles in 10-15 s)
 
 
 @ti.func
-def power(base, exponent: ti.template()):
-    """base^exponent for base >= 0 (elementwise) as exp(exponent log base), 0 at base 0: about half the cost
-    of float64 pow."""
+def lanewise_exp(x):
+    """elementary.exp of each of the LANES entries of x (inlined: no libm call)."""
+    return ti.Vector([elementary.exp(x[l]) for l in ti.static(range(LANES))], dt=ti.f64)
+
+
+@ti.func
+def lanewise_log(x):
+    """elementary.log of each of the LANES entries of x (> 0)."""
+    return ti.Vector([elementary.log(x[l]) for l in ti.static(range(LANES))], dt=ti.f64)
+
+
+@ti.func
+def power(base, exponent):
+    """base^exponent for base >= 0 (elementwise) as exp(exponent log base), 0 at base 0."""
     positive = base > 0.0
-    return ti.select(positive, ti.exp(exponent * ti.log(ti.select(positive, base, 1.0))), 0.0)
+    return ti.select(positive, lanewise_exp(exponent * lanewise_log(ti.select(positive, base, 1.0))), 0.0)
 
 
 @ti.func
@@ -304,18 +412,20 @@ def on_bed(sx: ti.f64, sz: ti.f64, radius: ti.f64, dz: ti.f64, theta: ti.templat
 
 
 @ti.func
+def row(s: ti.template(), j: ti.template()):
+    """Row j of a (SEEN, LANES) matrix as a LANES vector."""
+    return ti.Vector([s[j, l] for l in ti.static(range(LANES))], dt=ti.f64)
+
+
+@ti.func
 def velocity_lanes(p0: ti.i32, n: ti.i32, u: ti.template(), v: ti.template(), radius: ti.template(),
-                   density: ti.template(), s_u: ti.template(), s_v: ti.template(), s_dpdx: ti.template(),
-                   s_dpdz: ti.template(), s_dtaudx: ti.template(), s_dtaudz: ti.template(),
-                   s_theta: ti.template(), s_mean_u: ti.template(), s_mean_v: ti.template(),
-                   s_damping: ti.template(), s_width: ti.template(), dt: ti.f64, rho_f: ti.f64, mu: ti.f64,
+                   density: ti.template(), s: ti.template(), dt: ti.f64, rho_f: ti.f64, mu: ti.f64,
                    gravity: ti.f64, theta_cp: ti.f64, epsilon: ti.f64, restitution: ti.f64, law: ti.i32,
-                   re_coefficient: ti.f64, bridging_factor: ti.f64, iterations: ti.i32, x: ti.template(),
-                   z: ti.template(), x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, theta_grid: ti.template(),
-                   width: ti.template(), bed_friction: ti.f64, friction_fraction: ti.f64):
-    """New velocities (Eq. 43 with the packing limiter, bed friction and bridging of particle_ops_numpy.push),
-    D_p of the last drag solve and the bridged flags of the LANES parcels p0, p0 + 1, ... (vectors; lanes past
-    n repeat the last parcel).
+                   re_coefficient: ti.f64, iterations: ti.i32, bed_friction: ti.f64):
+    """New velocities (Eq. 43 with the packing limiter of particle_ops_numpy.push), D_p of the last drag solve
+    and the most speed that bed friction can take (dt mu_b |g'| / den, particle_ops_numpy._bed_friction) of the
+    LANES parcels p0, p0 + 1, ... (vectors; lanes past n repeat the last parcel), which see s (SEEN, LANES),
+    rows in the order of ParcelFluid. One power Re^a per drag iteration, a = 0.687 or 2/3 by the law.
 
     D_p = 4.5 mu / (rho_p r^2) x C_d Re / 24 (Eq. 13-15, closures.drag_rate): law 0 Eq. 14 (theta_f^-2.65
     (1 + c Re^0.687) below Re = 1000, else 0.44 Re / 24 theta_f^-2.65), law 1 Snider (2001)."""
@@ -323,99 +433,129 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, u: ti.template(), v: ti.template(), ra
     r = lanes(radius, p0, n)
     u0 = lanes(u, p0, n)
     v0 = lanes(v, p0, n)
-    uf = lanes(s_u, p0, n)
-    vf = lanes(s_v, p0, n)
-    dpdx = lanes(s_dpdx, p0, n)
-    dpdz = lanes(s_dpdz, p0, n)
-    theta = lanes(s_theta, p0, n)
-    mean_u = lanes(s_mean_u, p0, n)
-    mean_v = lanes(s_mean_v, p0, n)
-    half_rate = 0.5 * lanes(s_damping, p0, n)
-    buoyant_g = (1.0 - rho_f / rho_p) * gravity
-    log_tf = ti.log(1.0 - ti.min(theta, theta_cp))  # theta_f of closures.fluid_fraction
-    hinder = ti.exp(-2.65 * log_tf)
+    uf = row(s, 0)
+    vf = row(s, 1)
+    dpdx = row(s, 2)
+    dpdz = row(s, 3)
+    theta = row(s, 6)
+    mean_u = row(s, 7)
+    mean_v = row(s, 8)
+    half_rate = 0.5 * row(s, 9)
+    inv_rho = 1.0 / rho_p
+    buoyant_g = (1.0 - rho_f * inv_rho) * gravity
+    log_tf = lanewise_log(1.0 - ti.min(theta, theta_cp))  # theta_f of closures.fluid_fraction
+    hinder = lanewise_exp(-2.65 * log_tf)
     hinder_snider = hinder * 0.0
     if law == 1:
-        hinder_snider = ti.exp(-1.78 * log_tf)
-    stokes = 4.5 * mu / (rho_p * (r * r))
-    re_per_slip = 2.0 * rho_f * r / mu
+        hinder_snider = lanewise_exp(-1.78 * log_tf)
+    exponent = 2.0 / 3.0 if law == 1 else 0.687
+    stokes = 4.5 * mu * inv_rho / (r * r)
+    re_per_slip = (2.0 * rho_f / mu) * r
+    force_u = u0 + dt * (half_rate * mean_u - dpdx * inv_rho)
+    force_v = v0 + dt * (half_rate * mean_v + buoyant_g - dpdz * inv_rho)
     un = u0
     vn = v0
     drag = u0 * 0.0
-    den = drag + 1.0
+    inv_den = drag + 1.0
     for _ in range(iterations):
         re = re_per_slip * ti.sqrt((uf - un) ** 2 + (vf - vn) ** 2)
+        re_power = power(re, exponent)
         factor = hinder
         if law == 1:
-            factor = hinder + power(re, 2.0 / 3.0) * hinder_snider / 6.0
+            factor = hinder + re_power * hinder_snider * (1.0 / 6.0)
         else:
-            factor = hinder * ti.select(re < 1000.0, 1.0 + re_coefficient * power(re, 0.687), 0.44 * re / 24.0)
+            factor = hinder * ti.select(re < 1000.0, 1.0 + re_coefficient * re_power, (0.44 / 24.0) * re)
         drag = stokes * factor
-        den = 1.0 + dt * (drag + half_rate)
-        un = (u0 + dt * (drag * uf - dpdx / rho_p + half_rate * mean_u)) / den
-        vn = (v0 + dt * (drag * vf - dpdz / rho_p + buoyant_g + half_rate * mean_v)) / den
-    scale = -dt / (ti.max(theta, epsilon) * rho_p * den)
-    gx = lanes(s_dtaudx, p0, n)
-    gz = lanes(s_dtaudz, p0, n)
+        inv_den = 1.0 / (1.0 + dt * (drag + half_rate))
+        un = (force_u + dt * drag * uf) * inv_den
+        vn = (force_v + dt * drag * vf) * inv_den
+    scale = -dt * inv_den * inv_rho / ti.max(theta, epsilon)
+    gx = row(s, 4)
+    gz = row(s, 5)
     un = un + limited(scale * gx, mean_u - un, gx, restitution)
     vn = vn + limited(scale * gz, mean_v - vn, gz, restitution)
-    bed = ti.Vector([on_bed((x[ti.min(p0 + l, n - 1)] - x0) / dx, (z[ti.min(p0 + l, n - 1)] - z0) / dz, r[l], dz,
-                            theta_grid, width, friction_fraction) for l in ti.static(range(LANES))], dt=ti.f64)
-    slide = ti.max(ti.abs(un) - dt * bed_friction * ti.abs(buoyant_g) / den, 0.0)
-    un = ti.select(bed > 0.0, ti.select(un < 0.0, -slide, slide), un)
-    bridged = lanes(s_width, p0, n) < bridging_factor * 2.0 * r
-    return ti.select(bridged, 0.0, un), ti.select(bridged, 0.0, vn), drag, bridged
+    return un, vn, drag, dt * bed_friction * ti.abs(buoyant_g) * inv_den
 
 
 @ti.func
-def move(p: ti.i32, x: ti.template(), z: ti.template(), u: ti.template(), v: ti.template(), x0: ti.f64,
-         z0: ti.f64, dx: ti.f64, dz: ti.f64, dt: ti.f64, width: ti.template(), cell_mask: ti.template(),
-         theta_grid: ti.template(), theta_cp: ti.f64):
-    """Eq. 44 for parcel p with its new velocity (u[p], v[p]), x first, then z; a move that blocked() stops is
-    cancelled and that velocity component set to 0 (particle_ops_numpy.push)."""
-    sx = (x[p] - x0) / dx
-    sz = (z[p] - z0) / dz
+def move(p: ti.i32, sx: ti.f64, sz: ti.f64, flag: ti.i32, x: ti.template(), z: ti.template(), u: ti.template(),
+         v: ti.template(), x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, dt: ti.f64, width: ti.template(),
+         cell_mask: ti.template(), theta_grid: ti.template(), theta_cp: ti.f64):
+    """Eq. 44 for parcel p at cell coordinates (sx, sz) with its new velocity (u[p], v[p]), x first, then z;
+    a move that blocked() stops is cancelled and that velocity component set to 0 (particle_ops_numpy.push).
+    A parcel of a QUIET cell (``flag``, stencil_flags) that stays in it is not stopped and skips the checks."""
     xn = x[p] + dt * u[p]
     sxn = (xn - x0) / dx
-    if blocked(sx, sz, sxn, sz, width, cell_mask, theta_grid, theta_cp):
-        xn = x[p]
-        sxn = sx
-        u[p] = 0.0
     zn = z[p] + dt * v[p]
-    if blocked(sxn, sz, sxn, (zn - z0) / dz, width, cell_mask, theta_grid, theta_cp):
-        zn = z[p]
-        v[p] = 0.0
+    szn = (zn - z0) / dz
+    stays = ti.floor(sxn + 0.5) == ti.floor(sx + 0.5) and ti.floor(szn + 0.5) == ti.floor(sz + 0.5)
+    if not (stays and flag & QUIET):
+        if blocked(sx, sz, sxn, sz, width, cell_mask, theta_grid, theta_cp):
+            xn = x[p]
+            sxn = sx
+            u[p] = 0.0
+        if blocked(sxn, sz, sxn, szn, width, cell_mask, theta_grid, theta_cp):
+            zn = z[p]
+            v[p] = 0.0
     x[p] = xn
     z[p] = zn
+
+
+@ti.func
+def push_lanes(p0: ti.i32, n: ti.i32, s: ti.template(), x: ti.template(), z: ti.template(), u: ti.template(),
+               v: ti.template(), radius: ti.template(), density: ti.template(), state: ti.template(),
+               x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, flags: ti.template(), width: ti.template(),
+               cell_mask: ti.template(), theta_grid: ti.template(), dt: ti.f64, rho_f: ti.f64, mu: ti.f64,
+               gravity: ti.f64, theta_cp: ti.f64, epsilon: ti.f64, restitution: ti.f64, law: ti.i32,
+               re_coefficient: ti.f64, bridging_factor: ti.f64, iterations: ti.i32, bed_friction: ti.f64,
+               friction_fraction: ti.f64, drag_out: ti.template()):
+    """Eq. 43-44 in place for the LANES parcels p0, p0 + 1, ... (< n) that see s: velocity_lanes; then per
+    parcel bed friction (on_bed) and bridging (particle_ops_numpy.push), and move."""
+    un, vn, drag, friction = velocity_lanes(p0, n, u, v, radius, density, s, dt, rho_f, mu, gravity, theta_cp,
+                                            epsilon, restitution, law, re_coefficient, iterations, bed_friction)
+    seen_width = row(s, SEEN - 1)
+    for l in ti.static(range(LANES)):
+        if p0 + l < n:
+            u[p0 + l] = un[l]
+            v[p0 + l] = vn[l]
+            drag_out[p0 + l] = drag[l]
+    for l in range(ti.cast(ti.min(LANES, n - p0), ti.i32)):
+        p = p0 + l
+        sx = (x[p] - x0) / dx
+        sz = (z[p] - z0) / dz
+        flag = owner_flags(sx, sz, flags)
+        if not flag & LOOSE:
+            if on_bed(sx, sz, radius[p], dz, theta_grid, width, friction_fraction) > 0.0:
+                speed = ti.max(ti.abs(u[p]) - friction[l], 0.0)
+                u[p] = -speed if u[p] < 0.0 else speed
+        state[p] = ti.cast(0, ti.i32)
+        if seen_width[l] < bridging_factor * 2.0 * radius[p]:
+            u[p] = 0.0
+            v[p] = 0.0
+            state[p] = ti.cast(1, ti.i32)
+        move(p, sx, sz, flag, x, z, u, v, x0, z0, dx, dz, dt, width, cell_mask, theta_grid, theta_cp)
 
 
 @ti.kernel
 def push(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, state: I1,
          s_u: F1, s_v: F1, s_dpdx: F1, s_dpdz: F1, s_dtaudx: F1, s_dtaudz: F1,
          s_theta: F1, s_mean_u: F1, s_mean_v: F1, s_damping: F1, s_width: F1,
-         x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, width: F2, cell_mask: F2, theta_grid: F2,
+         x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, flags: I2, width: F2, cell_mask: F2, theta_grid: F2,
          dt: ti.f64, rho_f: ti.f64, mu: ti.f64, gravity: ti.f64,
          theta_cp: ti.f64, epsilon: ti.f64, restitution: ti.f64, law: ti.i32, re_coefficient: ti.f64,
          bridging_factor: ti.f64, iterations: ti.i32, bed_friction: ti.f64, friction_fraction: ti.f64,
          drag_out: F1):
-    """Eq. 43-44 in place with what the parcels see (s_*, the rows of ParcelFluid); D_p into drag_out.
-    One task per LANES parcels: velocity_lanes, then move for each."""
+    """Eq. 43-44 in place with what the parcels see (s_*, the rows of ParcelFluid); D_p into drag_out; flags of
+    stencil_flags. One task per LANES parcels (push_lanes)."""
     n = ti.cast(x.shape[0], ti.i32)
     for q in range(ti.cast((n + LANES - 1) // LANES, ti.i32)):
         p0 = ti.cast(q * LANES, ti.i32)
-        un, vn, drag, bridged = velocity_lanes(p0, n, u, v, radius, density, s_u, s_v, s_dpdx, s_dpdz, s_dtaudx,
-                                               s_dtaudz, s_theta, s_mean_u, s_mean_v, s_damping, s_width, dt,
-                                               rho_f, mu, gravity, theta_cp, epsilon, restitution, law,
-                                               re_coefficient, bridging_factor, iterations, x, z, x0, z0, dx,
-                                               dz, theta_grid, width, bed_friction, friction_fraction)
-        for l in ti.static(range(LANES)):
-            if p0 + l < n:
-                u[p0 + l] = un[l]
-                v[p0 + l] = vn[l]
-                drag_out[p0 + l] = drag[l]
-                state[p0 + l] = ti.cast(bridged[l], ti.i32)
-        for p in range(p0, ti.cast(ti.min(p0 + LANES, n), ti.i32)):
-            move(p, x, z, u, v, x0, z0, dx, dz, dt, width, cell_mask, theta_grid, theta_cp)
+        s = ti.Matrix([[arr[ti.min(p0 + l, n - 1)] for l in ti.static(range(LANES))]
+                       for arr in ti.static((s_u, s_v, s_dpdx, s_dpdz, s_dtaudx, s_dtaudz, s_theta, s_mean_u,
+                                             s_mean_v, s_damping, s_width))], dt=ti.f64)
+        push_lanes(p0, n, s, x, z, u, v, radius, density, state, x0, z0, dx, dz, flags, width, cell_mask,
+                   theta_grid, dt, rho_f, mu, gravity, theta_cp, epsilon, restitution, law, re_coefficient,
+                   bridging_factor, iterations, bed_friction, friction_fraction, drag_out)
 
 
 @ti.func
@@ -436,7 +576,7 @@ def face_force(along_x: ti.template(), p: ti.i32, u: ti.template(), v: ti.templa
 @ti.kernel
 def exchange_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles: F1,
                   s_u: F1, s_v: F1, s_dpdx: F1, s_dpdz: F1, drag: F1,
-                  x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, mask: F2, along_x: ti.template(),
+                  x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, mask: F2, flags: I2, along_x: ti.template(),
                   blocks: ti.i32, private: ti.template(), out: F4):
     """Face sums of n rho_p V_p [D (u_f - u_p) - grad p / rho_p] I (numerators of Eq. 39) for x-faces
     (along_x, mask (nz, nx+1)) or z-faces (mask (nz+1, nx)) into out (copies, faces..., 1), zeroed by the
@@ -449,13 +589,8 @@ def exchange_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles
         kb = -1
         ib = -1
         for p in range(start, end):
-            sx = (x[p] - x0) / dx
-            sz = (z[p] - z0) / dz
-            if ti.static(along_x):
-                sx += 0.5
-            else:
-                sz += 0.5
-            k0, i0, w = bilinear(sx, sz, mask)
+            k0, i0, w = deposit_weights((x[p] - x0) / dx, (z[p] - z0) / dz, ti.static(0.5 if along_x else 0.0),
+                                        ti.static(0.0 if along_x else 0.5), mask, flags)
             if k0 != kb or i0 != ib:
                 if kb != -1 or ib != -1:
                     flush(out, copy, kb, ib, acc, 1, private)

@@ -100,6 +100,8 @@ class TaichiBackend:
         self._k = kp
         self._copies: dict[str, np.ndarray] = {}
         self._outputs: dict[tuple[int, ...], list[np.ndarray]] = {}
+        self._interior: tuple[np.ndarray, np.ndarray] | None = None  # (width, its INTERIOR flags)
+        self._push_flags = np.empty((0, 0), dtype=np.int32)
 
     def _output(self, shape: tuple[int, ...]) -> np.ndarray:
         """An uninitialised output array of ``shape``: a cached one that nothing outside this cache refers to
@@ -143,19 +145,37 @@ class TaichiBackend:
         buf, blocks, private = self._deposit_buffer("cell", parcels.n, (nz, nx, len(ref.MOMENT_CHANNELS)))
         if parcels.n:
             self._k.moment_sums(parcels.x, parcels.z, parcels.u, parcels.v, parcels.radius, parcels.density,
-                                parcels.particles, frame.x0, frame.z0, frame.dx, frame.dz, cell_mask, blocks,
-                                private, buf)
+                                parcels.particles, frame.x0, frame.z0, frame.dx, frame.dz, cell_mask,
+                                self._flags(width), blocks, private, buf)
         return ref.finish_moments(np.moveaxis(buf.sum(axis=0), -1, 0), frame, width)
+
+    def _flags(self, width: np.ndarray, theta: np.ndarray | None = None, params: MppicParams | None = None
+               ) -> np.ndarray:
+        """kernels.particles.stencil_flags of the grid (cells whose parcels take the kernels' fast paths). Without
+        theta_p and params (deposits, gather) only the bit INTERIOR counts: those flags are kept and reused
+        while the width field stays the same (a launch and a pass over the grid cost about as much as 1e4
+        parcels)."""
+        if params is None:
+            if self._interior is None or not np.array_equal(self._interior[0], width):
+                flags = np.empty(width.shape, dtype=np.int32)
+                self._k.stencil_flags(width, width, np.inf, np.inf, flags)
+                self._interior = (width.copy(), flags)
+            return self._interior[1]
+        flags = self._push_flags if self._push_flags.shape == width.shape else np.empty(width.shape, np.int32)
+        self._k.stencil_flags(width, theta, params.theta_cp, params.friction_volume_fraction, flags)
+        self._push_flags = flags
+        return flags
 
     def gather(self, parcels: Parcels, frame: GridFrame, fields: GridFields) -> ParcelFluid:
         """Grid fields at the parcels (Eq. 40-41)."""
         seen = self._output((self._k.SEEN, parcels.n))
         if parcels.n:
             f = fields
-            self._k.gather(parcels.x, parcels.z, frame.x0, frame.z0, frame.dx, frame.dz,
-                           f.cell_mask, f.xface_mask, f.zface_mask, f.fluid_u, f.fluid_v, f.dpdx, f.dpdz,
-                           f.dtaudx, f.dtaudz, f.volume_fraction, f.mean_u, f.mean_v, f.damping_rate, f.width,
-                           seen)
+            flat = [np.ascontiguousarray(a).reshape(-1) for a in (
+                f.fluid_u, f.fluid_v, f.dpdx, f.dpdz, f.dtaudx, f.dtaudz, f.volume_fraction, f.mean_u, f.mean_v,
+                f.damping_rate, f.width)]
+            self._k.gather(parcels.x, parcels.z, frame.x0, frame.z0, frame.dx, frame.dz, self._flags(f.width),
+                           f.cell_mask, f.xface_mask, f.zface_mask, *flat, seen)
         return ParcelFluid(*seen)
 
     def push(self, parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFields, dt: float,
@@ -168,7 +188,8 @@ class TaichiBackend:
             self._k.push(parcels.x, parcels.z, parcels.u, parcels.v, parcels.radius, parcels.density,
                          parcels.state, s.fluid_u, s.fluid_v, s.dpdx, s.dpdz, s.dtaudx, s.dtaudz,
                          s.volume_fraction, s.mean_u, s.mean_v, s.damping_rate, s.width,
-                         frame.x0, frame.z0, frame.dx, frame.dz, fields.width, fields.cell_mask,
+                         frame.x0, frame.z0, frame.dx, frame.dz,
+                         self._flags(fields.width, fields.volume_fraction, params), fields.width, fields.cell_mask,
                          fields.volume_fraction, dt, fluid_density, fluid_viscosity, gravity,
                          *self._push_constants(params), drag)
         return drag
@@ -186,13 +207,14 @@ class TaichiBackend:
         nz, nx = ref.check_width(width)
         _, xmask, zmask = active_nodes(width)
         sums = []
+        flags = self._flags(width)
         for key, mask, along_x in (("xface", xmask, True), ("zface", zmask, False)):
             buf, blocks, private = self._deposit_buffer(key, parcels.n, mask.shape + (1,))
             if parcels.n:
                 self._k.exchange_sums(parcels.x, parcels.z, parcels.u, parcels.v, parcels.radius,
                                       parcels.density, parcels.particles, seen.fluid_u, seen.fluid_v, seen.dpdx,
-                                      seen.dpdz, drag, frame.x0, frame.z0, frame.dx, frame.dz, mask, along_x,
-                                      blocks, private, buf)
+                                      seen.dpdz, drag, frame.x0, frame.z0, frame.dx, frame.dz, mask, flags,
+                                      along_x, blocks, private, buf)
             sums.append(buf.sum(axis=0)[..., 0])
         wxf, wzf = face_widths(width)
         return ref.per_face_volume(sums[0], frame, wxf), ref.per_face_volume(sums[1], frame, wzf)

@@ -271,3 +271,27 @@ def test_bad_fluid_shapes_are_named():
         grid_fields(frame, width, fluid["u"], fluid["v"][:-1], fluid["pressure"], moments, MppicParams())
     with pytest.raises(ValueError, match="mppic.backend"):
         get_backend("cuda-python")
+
+
+def test_stencil_flags_match_their_definition(taichi_backend):
+    """kernels.particles.stencil_flags (the cells whose parcels take the kernels' fast paths) against the
+    definition in NumPy: INTERIOR = the 3 x 3 cells around are in the grid and open, QUIET = also all below
+    theta_cp, LOOSE = INTERIOR and the cell and the one below it below friction_volume_fraction."""
+    from hfgpu.kernels import particles as kp
+
+    rng = np.random.default_rng(7)
+    nz, nx = 9, 11
+    width = rng.uniform(1e-3, 3e-3, (nz, nx))
+    width[rng.random((nz, nx)) < 0.1] = 0.0
+    theta = rng.uniform(0.0, 0.7, (nz, nx))
+    flags = np.empty((nz, nx), dtype=np.int32)
+    kp.stencil_flags(width, theta, 0.6, 0.5, flags)
+    for k in range(nz):
+        for i in range(nx):
+            inside = 1 <= k < nz - 1 and 1 <= i < nx - 1
+            block = (slice(max(k - 1, 0), k + 2), slice(max(i - 1, 0), i + 2))
+            interior = inside and np.all(width[block] > 0.0)
+            quiet = interior and np.all(theta[block] < 0.6)
+            loose = interior and theta[k, i] < 0.5 and theta[k + 1, i] < 0.5
+            assert flags[k, i] == kp.INTERIOR * interior + kp.QUIET * quiet + kp.LOOSE * loose, (k, i)
+    assert np.any(flags & kp.QUIET) and np.any(flags & kp.LOOSE) and np.any(flags == kp.INTERIOR)
