@@ -44,11 +44,11 @@ def run(scene):
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cases", default="I,II,III,long")
+    parser.add_argument("--cases", default="I,II,III,long", help="any of I,II,III,IV,long (IV: minutes)")
     parser.add_argument("--max-cells-across", type=int, default=40, help="footprint cap of the long run")
     args = parser.parse_args()
     print(f"{'case':6} {'cell [m]':>9} {'end cell':>9} {'cells':>6} {'steps':>6} {'newton':>7} {'retries':>7} "
-          f"{'wall [s]':>9} {'R err':>8} {'Rmin err':>9} {'Rmax err':>9} {'w0 err':>8}")
+          f"{'rejected':>8} {'wall [s]':>9} {'R err':>8} {'Rmin err':>9} {'Rmax err':>9} {'w0 err':>8}")
     for name in args.cases.split(","):
         scene = load_scene(SCENES / f"radial_{name}.toml")
         if name == "long":
@@ -56,7 +56,7 @@ def main() -> None:
         out, wall, r_err, w_err = run(scene)
         ref_r = out["radius"] / (1 + r_err)
         print(f"{name:6} {scene.mesh.dx:9.3g} {out['dx']:9.3g} {out['cells']:6d} {out['steps']:6d} "
-              f"{out['newton_iterations']:7d} {out['retries']:7d} {wall:9.2f} {r_err:+8.2%} {out['radius_min'] / ref_r - 1:+9.2%} "
+              f"{out['newton_iterations']:7d} {out['retries']:7d} {out['rejected']:8d} {wall:9.2f} {r_err:+8.2%} {out['radius_min'] / ref_r - 1:+9.2%} "
               f"{out['radius_max'] / ref_r - 1:+9.2%} {w_err:+8.2%}")
 
 

@@ -53,9 +53,10 @@ def test_case_III_storage_toughness_coarse():
 
 
 def test_case_II_leakoff_viscosity_coarse():
-    # Known limitation (see report): whole-cell Carter leak-off in tip cells; the radius is ~12 % long.
+    # Known limitation: whole-cell Carter leak-off in tip cells; measured R +8.0 %, w0 -3.0 % at 0.5 m cells
+    # (+12 % before steps were bounded by the measured front advance).
     out, sink, err, _ = run_case("II")
-    assert abs(err["R"]) < 0.15 and abs(err["w0"]) < 0.05, err
+    assert abs(err["R"]) < 0.10 and abs(err["w0"]) < 0.05, err
     assert out["max_balance_error"] < 1e-3
 
 
@@ -70,9 +71,9 @@ def test_case_I_refinement_reduces_the_radius_error():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="at 0.18 m cells Newton fails near t = 380 s after its step retries (K-regime "
-                          "stiffness; see report)", strict=False)
 def test_case_III_fine_meets_the_goal():
+    # measured R -0.85 % (front min/max -7.7 / +3.4 %), w0 +1.7 % at 0.18 m cells, no step retries (0.25 m:
+    # -1.2 % / +2.1 %; 0.125 m: -1.5 % / +4.0 %: within the goal, but not a series with falling error)
     _, _, err, _ = run_case("III", 0.18)
     assert abs(err["R"]) < 0.02 and abs(err["w0"]) < 0.05, err
 
@@ -94,10 +95,20 @@ def test_case_I_meets_the_goal_on_finer_grids():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="II: radius +12 % at 0.5 m cells, first order in the cell (+7.4 % at 0.25 m), not "
-                          "cured by partially filled tip cells; IV: Newton fails at a front cell mid-run "
-                          "(SimulationError near t = 34-68 s at 0.014 m cells)", strict=False)
+@pytest.mark.xfail(reason="II: radius +8 % at 0.5 m cells (whole-cell leak-off at the tip); IV: the inlet "
+                          "width swings by tens of % as whole rings of cells open (efficiency ~0.6 %: the "
+                          "stored volume is the small difference of injection and leak-off)", strict=False)
 @pytest.mark.parametrize("name", ["II", "IV"])
 def test_leakoff_cases_meet_the_goal(name):
     _, _, err, _ = run_case(name)
     assert abs(err["R"]) < 0.02 and abs(err["w0"]) < 0.05, err
+
+
+def test_case_IV_leakoff_toughness_finishes_with_the_balance():
+    # Newton used to fail at front cells mid-run (a line search on ||F||, and just-opened cells started at
+    # w = 0); now the coarse run (3.5 cm cells, ~11 per final radius) finishes without step retries. Measured:
+    # R +12.1 % (front min/max +1.6 / +25.6 %), w0 -71 % (2 cm cells: R +10.5 %, w0 -71 %): the stored volume
+    # (efficiency ~0.6 %) swings as whole rings of cells open, see above.
+    out, _, err, _ = run_case("IV", 0.035)
+    assert out["time"] == pytest.approx(407.0) and out["max_balance_error"] < 1e-9
+    assert abs(err["R"]) < 0.15, err
