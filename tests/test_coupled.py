@@ -100,6 +100,29 @@ def test_solid_balance_and_scheduled_solid(tiny):
     assert scheduled - 3 * parcel <= b["injected"][-1] <= scheduled * (1 + 1e-9)
 
 
+def test_fluid_supplied_is_the_width_histories_mismatch(tiny):
+    """Conservation of the fluid on the proppant grid: what the fluid step supplied beyond the inlets
+    (proppant_fluid_supplied) is the open volume the fracture history gained on the grid, plus its leak-off,
+    minus the fluid injected (1 - c) Q t, the solids now occupying the fracture and the fluid of cells that
+    opened (filled by the fracture's own flow), plus that of cells that closed."""
+    summary, r = tiny
+    history = FractureHistory(r.fracture_snapshots)
+    first, last = r.proppant_snapshots[0], r.proppant_snapshots[-1]
+    shape = np.shape(last.grid["width"])
+    area = last.frame.dx * last.frame.dz
+    volume = [np.sum(history.fields_at(t, last.frame, shape)[0]) * area for t in (20.0, 40.0)]
+    times = np.linspace(20.0, 40.0, 401)
+    leak = [np.sum(history.fields_at(t, last.frame, shape)[1]) * area for t in times]
+    leaked = float(np.sum(0.5 * (np.add(leak[1:], leak[:-1])) * np.diff(times)))
+    injected = 0.9 * 2e-3 * 20.0
+    assert summary["proppant_fluid_injected"] == pytest.approx(injected, rel=1e-9)
+    solids = r.proppant_balance["in_domain"][-1]
+    expected = (volume[1] - volume[0] + leaked - injected - solids - summary["proppant_fluid_opened"]
+                + summary["proppant_fluid_dropped"])
+    assert first.time == 20.0
+    assert summary["proppant_fluid_supplied"] == pytest.approx(expected, abs=2e-4 * injected)
+
+
 def test_parcels_stay_inside_open_cells_and_width_follows_the_fracture(tiny):
     _, r = tiny
     history = FractureHistory(r.fracture_snapshots)
@@ -127,10 +150,11 @@ def test_screen_out_flags_are_recorded_and_match_the_criterion(tiny):
 
 @pytest.fixture(scope="module")
 def screened(tmp_path_factory):
-    """TINY with 1 mm grains at 30 % loading: they bridge at the perforation and the inlet ring packs."""
+    """TINY with 0.5 mm grains at 30 % loading: they fit the width but bridge (w < 2 d) at the perforation and
+    the inlet ring packs."""
     path = tmp_path_factory.mktemp("screen") / "screened.h5"
     scene = load_scene(TINY.replace("volume_fraction = 0.1", "volume_fraction = 0.3")
-                       .replace('"300 um"', '"1000 um"'))
+                       .replace('"300 um"', '"500 um"'))
     with pytest.warns(RuntimeWarning, match="screen-out: the inlets held back"):
         summary = run(scene, path, progress=False)
     return summary, open_results(path)

@@ -230,10 +230,10 @@ class ProppantSimulation:
                 continue
             if info.courant <= self.numerics.c_max:
                 break
-            dt *= 0.5
+            dt *= min(0.5, 0.9 * self.numerics.c_max / info.courant)
         else:
             raise SimulationError(f"the fluid Courant number stayed above c_max = {self.numerics.c_max:g} "
-                                  f"after {self.numerics.max_step_retries} halvings of the step", time=t0)
+                                  f"after {self.numerics.max_step_retries} reductions of the step", time=t0)
         self.fluid = trial
         for name in FLUID_VOLUMES:
             self.fluid_totals[name] += getattr(info, name)
@@ -247,9 +247,11 @@ class ProppantSimulation:
 
     def _inject(self, t0: float, t1: float) -> None:
         """Add the inlets' parcels for (t0, t1] into the room left below close packing, theta_cp V_cell minus
-        the solid volume of the scatter (Eq. 38) on the step's width; what cannot enter is screened out."""
+        the solid volume of the scatter (Eq. 38) on the step's width, and none where the width is below the
+        largest grain; what cannot enter is screened out."""
         moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
         room = np.maximum(self.params.theta_cp * self.grid.cell_volume - moments.solid_volume, 0.0)
+        room[self.grid.width < max(c.size.d_max for c in self.setup.classes)] = 0.0
         held = self.injector.screened_out
         self.add_parcels(self.injector.emit(t0, t1, room=room, width=self.grid.width))
         held = self.injector.screened_out - held
@@ -442,7 +444,7 @@ def warn_screen_out(summary: dict, theta_cp: float, offset: float = 0.0) -> None
         warnings.warn(f"screen-out: the inlets held back {summary['screened_out']:.4g} m^3 of proppant "
                       f"({100 * summary['screened_out'] / summary['injected']:.1f} % of the injected solids), "
                       f"first at t = {summary['screen_out_time'] + offset:g} s: their cells were packed to "
-                      f"theta_cp = {theta_cp:g}", RuntimeWarning, stacklevel=3)
+                      f"theta_cp = {theta_cp:g} or narrower than the largest grain", RuntimeWarning, stacklevel=3)
 
 
 def simulate(scene, sink, progress: Callable[[float], None] | None = None,
