@@ -63,6 +63,9 @@ def main() -> None:
     print(f"\ncreated area {r['created_area']:.0f} m^2, propped area {r['propped_area']:.0f} m^2 "
           f"({100 * r['propped_fraction']:.1f} %), screen-out cells {r['screen_out_cells']}")
     print("packed parcel fraction (the paper's Fig. 16 times, scaled to the slurry period): " + ", ".join(f"{f:.2f} at {t:.0f} s" for t, f in r["packed"]))
+    supplied, injected = summary["proppant_fluid_supplied"], summary["proppant_fluid_injected"]
+    print(f"fluid supplied for the fracture width history's mismatch: {supplied:.3g} m^3 "
+          f"({100 * supplied / injected:+.1f} % of the injected fluid)")
     print("wall time [s]: " + ", ".join(f"{k[5:]} {summary[k]:.1f}" for k in summary if k.startswith("time_")))
 
 

@@ -7,10 +7,10 @@ from __future__ import annotations
 import h5py
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from hfgpu.coupling import (FractureHistory, bridging_risk, overlap_lengths, proppant_frame, resample_earliest,
+from hfgpu.coupling import (_SLIVER, FractureHistory, bridging_risk, overlap_lengths, proppant_frame, resample_earliest,
                             resample_mean)
 from hfgpu.fracture.coarsen import coarsen
 from hfgpu.io.results import ResultsWriter
@@ -91,13 +91,17 @@ def test_whole_cell_shift_moves_values_and_closed_cells_stay_exactly_zero():
 @settings(max_examples=60, deadline=None)
 @given(st.floats(0.05, 3.0), st.floats(0.05, 3.0), st.floats(-50.0, 50.0), st.floats(0.0, 0.999),
        st.integers(1, 9), st.integers(0, 3))
+@example(2.0, 1.0, 0.0, 1.9082149292705877e-10, 1, 0)
 def test_overlap_keeps_every_covered_source_length(h_src, h_dst, c_src, u, n_src, extra):
-    """1-D: a target covering the source gives each source cell its full length (column sums = h_src)."""
+    """1-D: a target covering the source gives each source cell its full length (column sums = h_src); a
+    target cell's overlaps sum to at most its length, within the sliver tolerance (an overlap shorter than
+    _SLIVER x the smaller cell is dropped and its length returned to the column's other overlaps: hypothesis
+    found u = 1.9e-10, h_src = 2, h_dst = 1, where that pushes one target cell 2e-10 over its length)."""
     left = c_src - 0.5 * h_src - u * h_dst
     n_dst = int(np.ceil((n_src * h_src + u * h_dst) / h_dst)) + extra
     a = overlap_lengths(c_src, h_src, n_src, left + 0.5 * h_dst, h_dst, n_dst)
     np.testing.assert_allclose(a.sum(axis=0), h_src, rtol=1e-12)
-    assert np.all(a >= 0.0) and np.all(a.sum(axis=1) <= h_dst * (1 + 1e-12))
+    assert np.all(a >= 0.0) and np.all(a.sum(axis=1) <= h_dst * (1 + 1e-12) + _SLIVER * min(h_src, h_dst))
 
 
 def test_target_smaller_than_source_keeps_only_the_covered_part():

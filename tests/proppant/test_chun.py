@@ -38,14 +38,16 @@ def test_slot_scene_matches_the_experiment():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="bank AREA within 2 % from 17.5 s (+32 % at 10 s, +10 % at 15 s) but bank LENGTH too long: "
-                          "0.72-0.73 at 10-22.5 s (exp. 0.55-0.65, +31 % to +13 %), 0.81-0.83 at 25-30 s (exp. "
-                          "0.67-0.75, +20 % to +11 %). Bed friction (Coulomb, mu_b = 0.543 on the grains resting "
-                          "on the floor or on a dense bed) brought it down from 1.0 (bank from the far wall): the "
-                          "slurry still sinks from the momentum-free inlet sources as a gravity current along the "
-                          "bottom at ~0.4 m/s, whose drag on a grain (D_p ~ 100/s x slip) exceeds the friction of "
-                          "its submerged weight (3.2 m/s^2) until the bed has grown; the bank spans 0.66 of the "
-                          "slot at 5 s.",
+@pytest.mark.xfail(reason="bank AREA within 3 % from 17.5 s (+33 % at 10 s, +9 % at 15 s) but bank LENGTH too long: "
+                          "0.77 at 10-25 s (exp. 0.55-0.67, +39 % to +14 %), 0.84 at 27.5-30 s (exp. 0.71-0.75, +19 %, "
+                          "+13 %); at 5 s the bank is one packed bottom row spanning 0.70 of the slot. Without the "
+                          "jets, the inflow sinks at the inlets and runs along the bottom as a dense underflow "
+                          "(0.4-0.47 m/s in the lower 40 % of the slot at 5 s, returning above) that lays a thin bed "
+                          "far from the inlet; the inlet jets (momentum source, chun2020_slot.toml) lengthen the bank "
+                          "by 0.03-0.05 of the slot at 2.5-22.5 s (without: 0.72-0.83, +31 % to +11 %): missing inlet "
+                          "momentum is not the cause. Nor is the grid: with 9.525 mm cells the bank is longer still "
+                          "(0.80 at 10 s, +45 %; area +33 %). Open: the underflow's resistance (laminar wall friction "
+                          "12 mu/(rho w^2) at a gap Reynolds number ~1000-2500).",
                    strict=False)
 def test_chun_bank_length_and_area(shared_dir):
     data = np.loadtxt(shared_dir / "validation-data" / "chun_2020_bank_length_area_geos.txt")
