@@ -69,25 +69,10 @@ every = "{every}"
 
 
 def coupled_text(diameter: str) -> str:
-    """A small coupled scene: a 12 m pay between 2 MPa barriers, 20 s pad then 20 s of 10 % slurry of
-    ``diameter`` grains (tests/test_coupled.py's tiny scene, built here)."""
-    schedule = ('[{ until = "20 s", rate = "2e-3 m**3/s" }, '
-                '{ until = "40 s", rate = "2e-3 m**3/s", proppant = "sand", volume_fraction = 0.1 }]')
-    extra = f"""
-[[proppant]]
-name = "sand"
-diameter = "{diameter}"
-density = "2650 kg/m**3"
-[mppic]
-backend = "numpy"
-parcels_per_cell = 4
-dt_max = "0.25 s"
-[coupling]
-fracture_every = "5 s"
-"""
-    return fracture_text(end_time="40 s", schedule=schedule, cell="1.5 m", K="0.1 MPa*m**0.5",
-                         CL="1e-6 m/s**0.5", mu="0.02 Pa*s", layers=barrier_layers(12.0, 2.0), every="10 s",
-                         physics='["fracture", "proppant"]', extra=extra)
+    """tests/scenes/tiny_coupled.toml (a 12 m pay between 2 MPa barriers, 20 s pad then 20 s of 10 % slurry)
+    with ``diameter`` grains."""
+    text = (Path(__file__).parent / "scenes" / "tiny_coupled.toml").read_text()
+    return text.replace('diameter = "300 um"', f'diameter = "{diameter}"')
 
 
 def barrier_layers(thickness: float, contrast_mpa: float, base_mpa: float = 10.0) -> str:

@@ -23,50 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "hfgpu" / "scenes"
 
 #: A 12 m pay (10 MPa) between 12 MPa barriers; 20 s pad then 20 s of 10 % slurry. Small on purpose.
-TINY = """
-[run]
-end_time = "40 s"
-physics = ["fracture", "proppant"]
-seed = 1
-[rock]
-youngs_modulus = "30 GPa"
-poisson_ratio = 0.25
-toughness = "0.1 MPa*m**0.5"
-leakoff_coefficient = "1e-6 m/s**0.5"
-min_stress = "10 MPa"
-[[rock.layers]]
-top = "0 m"
-bottom = "494 m"
-min_stress = "12 MPa"
-[[rock.layers]]
-top = "494 m"
-bottom = "506 m"
-min_stress = "10 MPa"
-[[rock.layers]]
-top = "506 m"
-bottom = "1000 m"
-min_stress = "12 MPa"
-[fluid]
-viscosity = "0.02 Pa*s"
-[injection]
-depth = "500 m"
-schedule = [{ until = "20 s", rate = "2e-3 m**3/s" },
-            { until = "40 s", rate = "2e-3 m**3/s", proppant = "sand", volume_fraction = 0.1 }]
-[[proppant]]
-name = "sand"
-diameter = "300 um"
-density = "2650 kg/m**3"
-[mppic]
-backend = "numpy"
-parcels_per_cell = 4
-dt_max = "0.25 s"
-[mesh]
-cell_size = "1.5 m"
-[output]
-every = "10 s"
-[coupling]
-fracture_every = "5 s"
-"""
+TINY = (Path(__file__).parent / "scenes" / "tiny_coupled.toml").read_text()
 
 
 @pytest.fixture(scope="module")
