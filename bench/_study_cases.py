@@ -161,8 +161,9 @@ def _wu(scene: Scene) -> tuple[int, int, int, dict]:
     out = simulate(scene, sink)
     snaps = {round(s.time): s.extras for s in sink.fracture_snapshots}
     values = {}
+    unresolved = {k: 0.0 for k in ("front_up", "front_down", "front_left", "front_right")}
     for t in WU_TIMES:
-        e = snaps[round(t)]
+        e = snaps.get(round(t), unresolved)  # before the starting fracture forms: no resolved front (-100 %)
         values[f"up {t:g}"] = float(e["front_up"])
         values[f"down {t:g}"] = float(e["front_down"])
         values[f"lateral {t:g}"] = 0.5 * (float(e["front_left"]) + float(e["front_right"]))

@@ -11,7 +11,7 @@ Only real limits are here, each with its reason (docs/stability.md has the matri
   refused up front instead of failing hours in.
 
 What the engines already refuse themselves (not repeated here): a first stage with rate 0, a starting fracture
-that needs longer than the first stage to form (``fracture.initial_radius_cells``), c_max outside (0, 1).
+that needs longer than half the run to form (``fracture.initial_radius_cells``), c_max outside (0, 1).
 """
 
 from __future__ import annotations

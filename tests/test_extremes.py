@@ -108,7 +108,7 @@ def test_first_stage_without_rate_is_refused(tmp_path):
         run(load_scene(text), tmp_path / "r.h5", progress=False)
 
 
-def test_starting_fracture_that_cannot_form_in_the_first_stage_is_refused(tmp_path):
+def test_starting_fracture_that_cannot_form_in_the_first_half_of_the_run_is_refused(tmp_path):
     # K = 20 MPa m^0.5 at 1e-3 m^3/s on 2 m cells: the 5 m starting fracture needs 165 s (K vertex)
     text = fracture_text(K="20 MPa*m**0.5", cell="2 m", end_time="30 s")
     with pytest.raises(SceneError, match=r"fracture\.initial_radius_cells"):

@@ -34,6 +34,7 @@ import math
 from typing import Callable
 
 import numpy as np
+from scipy.optimize import brentq
 
 from ..errors import SceneError, SimulationError
 from ..records import BalanceRecord, FractureSnapshot, GridFrame
@@ -77,6 +78,24 @@ def initial_time(e_prime: float, mu_prime: float, k_prime: float, c_prime: float
     return float(times[i]), powers[i]
 
 
+def start_time(schedule, e_prime: float, mu_prime: float, k_prime: float, c_prime: float,
+               radius: float) -> tuple[float, float]:
+    """(t0, a) of :func:`initial_time` at the schedule's mean rate to t0: the root of
+    t0 = initial_time(q = V(t0) / t0) (the first stage's rate while t0 lies in it; bisection beyond, where
+    V(t) / t is continuous). The starting fracture then holds the volume injected to t0. inf when it never
+    reaches ``radius`` before the schedule ends."""
+    def late(t: float) -> float:
+        return initial_time(e_prime, mu_prime, k_prime, c_prime, schedule.volume(t) / t, radius)[0] - t
+
+    t0, power = initial_time(e_prime, mu_prime, k_prime, c_prime, schedule.stages[0].rate, radius)
+    if t0 <= schedule.stages[0].until:
+        return t0, power
+    if late(schedule.end) > 0.0:
+        return math.inf, power
+    t0 = brentq(late, schedule.stages[0].until, schedule.end, xtol=1e-12 * schedule.end)
+    return t0, initial_time(e_prime, mu_prime, k_prime, c_prime, schedule.volume(t0) / t0, radius)[1]
+
+
 class _Engine:
     """Mutable state of one run (grid fields, active-set systems, counters)."""
 
@@ -97,11 +116,13 @@ class _Engine:
         self._properties()
         k0 = K_PRIME_FACTOR * float(rock.toughness_at(np.array(inj.depth)))
         c0 = 2.0 * float(rock.leakoff_at(np.array(inj.depth)))
-        self.t0, power = initial_time(self.e_prime, self.mu_prime, k0, c0, self.schedule.stages[0].rate, r0)
-        if self.t0 >= self.schedule.stages[0].until:
+        self.t0, power = start_time(self.schedule, self.e_prime, self.mu_prime, k0, c0, r0)
+        if self.t0 >= 0.5 * self.schedule.end or self.schedule.rate(self.t0) <= 0.0:
             raise SceneError("fracture.initial_radius_cells", numerics.initial_radius_cells,
-                             f"the starting fracture ({r0:.3g} m) would take {self.t0:.3g} s to form, past the "
-                             f"first stage's end ({self.schedule.stages[0].until:g} s); use a finer mesh")
+                             f"the starting fracture ({r0:.3g} m) would take "
+                             f"{'longer than the schedule' if math.isinf(self.t0) else f'{self.t0:.3g} s'} to form, past half "
+                             f"the run ({self.schedule.end:g} s) or in a stage that does not inject; use a finer "
+                             f"mesh")
         g = self.grid
         xo, zo = g.offsets()
         r = np.hypot(xo, zo)
