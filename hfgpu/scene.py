@@ -383,6 +383,9 @@ def _parse_rock(t: Table) -> Rock:
     return Rock(layers=tuple(layers), **rock)
 
 
+STAGE_ENDS = ("until", "duration", "clean_volume")
+
+
 def _parse_injection(t: Table, proppant_densities: dict[str, float]) -> Injection:
     depth = t.quantity("depth", "length", 0.0)
     x = t.quantity("x", "length", 0.0)
@@ -394,16 +397,10 @@ def _parse_injection(t: Table, proppant_densities: dict[str, float]) -> Injectio
                          '[{ until = "370 s", rate = "0.053 m**3/s" }, ...]')
     for i, item in enumerate(raw):
         st = Table(item, f"{t.key_path('schedule')}[{i}]")
-        if st.has("duration") and st.has("until"):
-            raise SceneError(st.key_path("duration"), item["duration"], "give either 'until' or "
-                             "'duration', not both")
-        if st.has("duration"):
-            until = start + st.quantity("duration", "time", minimum=0.0, exclusive_minimum=True)
-        else:
-            until = st.quantity("until", "time")
-        if until <= start:
-            raise SceneError(st.key_path("until"), item.get("until"), f"stages must end in increasing "
-                             f"time; this one must end after {start:g} s")
+        ends = [key for key in STAGE_ENDS if st.has(key)]
+        if len(ends) > 1:
+            raise SceneError(st.key_path(ends[1]), item[ends[1]], f"give one of {list(STAGE_ENDS)}, not "
+                             f"{ends}")
         rate = st.quantity("rate", "rate", minimum=0.0)
         name = st.string("proppant") if st.has("proppant") else None
         fraction = end_fraction = 0.0
@@ -417,12 +414,35 @@ def _parse_injection(t: Table, proppant_densities: dict[str, float]) -> Injectio
                 if st.has(key):
                     raise SceneError(st.key_path(key), item[key], "a proppant loading needs "
                                      "'proppant = \"<class name>\"' in the same stage")
+        until = _stage_end(st, ends[0] if ends else "until", start, rate, 0.5 * (fraction + end_fraction))
         st.finish()
         stages.append(Stage(until=until, rate=rate, proppant=name, volume_fraction=fraction,
                             end_volume_fraction=end_fraction))
         start = until
     t.finish()
     return Injection(depth=depth, schedule=Schedule(tuple(stages)), x=x)
+
+
+def _stage_end(st: Table, key: str, start: float, rate: float, mean_fraction: float) -> float:
+    """End time of a stage that starts at ``start`` from ``until``, ``duration`` or ``clean_volume``.
+
+    A clean volume V_c [m^3 of fluid without proppant] at slurry rate Q and slurry fraction phi(t), linear in
+    time, lasts V_c / (Q (1 - mean phi)): the clean-fluid rate Q (1 - phi) is linear, so its mean is exact.
+    """
+    if key == "until":
+        until = st.quantity("until", "time")
+    elif key == "duration":
+        until = start + st.quantity("duration", "time", minimum=0.0, exclusive_minimum=True)
+    else:
+        volume = st.quantity("clean_volume", "volume", minimum=0.0, exclusive_minimum=True)
+        if rate <= 0.0:
+            raise SceneError(st.key_path("clean_volume"), st.data["clean_volume"], "a stage that ends by "
+                             "its clean volume needs a rate > 0; give 'until' or 'duration' for a shut-in")
+        until = start + volume / (rate * (1.0 - mean_fraction))
+    if until <= start:
+        raise SceneError(st.key_path(key), st.data.get(key), f"stages must end in increasing time; this one "
+                         f"must end after {start:g} s")
+    return until
 
 
 def _stage_fractions(st: Table, density: float) -> tuple[float, float]:

@@ -76,6 +76,32 @@ schedule = [{ until = "10 s", rate = "6 gpm", proppant = "sand", concentration =
     assert err.value.path == "geometry.inlets[0].jet" and "'+x'" in str(err.value)
 
 
+def test_stage_ends_by_clean_volume():
+    """A stage given by clean volume V_c lasts V_c / (Q (1 - mean phi)): 100 bbl of clean fluid at
+    20 bbl/min of slurry ramped 0.1 -> 0.3 (mean 0.2) takes 100 / (20 * 0.8) min = 375 s."""
+    text = BOX.replace('kind = "box"', 'kind = "slot"').replace("[[proppant]]", """
+[[geometry.inlets]]
+kind = "point"
+x = 0
+depth = "10 cm"
+[[geometry.outlets]]
+kind = "point"
+x = "5 cm"
+depth = "10 cm"
+[injection]
+schedule = [{ until = "60 s", rate = "20 bbl/min" },
+            { clean_volume = "100 bbl", rate = "20 bbl/min", proppant = "sand", volume_fraction = 0.1, end_volume_fraction = 0.3 }]
+[[proppant]]""", 1)
+    schedule = load_scene(text).injection.schedule
+    assert schedule.breakpoints() == pytest.approx((60.0, 60.0 + 375.0), rel=1e-12)
+    with pytest.raises(SceneError) as err:
+        load_scene(text.replace('clean_volume = "100 bbl"', 'clean_volume = "100 bbl", duration = "5 s"'))
+    assert err.value.path == "injection.schedule[1].clean_volume" and "not" in str(err.value)
+    with pytest.raises(SceneError) as err:
+        load_scene(text.replace('"100 bbl", rate = "20 bbl/min"', '"100 bbl", rate = 0'))
+    assert err.value.path == "injection.schedule[1].clean_volume" and "rate > 0" in str(err.value)
+
+
 @pytest.mark.parametrize("old, new, path", [
     ('kind = "box"', 'kind = "tube"', "geometry.kind"),
     ('width = "5 cm"', 'width = "-5 cm"', "geometry.width"),
