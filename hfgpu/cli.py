@@ -25,6 +25,8 @@ def _parser() -> argparse.ArgumentParser:
                      "checkpoint (the scene must be the same); a complete file is left alone")
     run.add_argument("--rrd", type=Path, help="also save a Rerun recording to this .rrd file")
     run.add_argument("--view", action="store_true", help="stream to a Rerun viewer (spawned)")
+    run.add_argument("--connect", metavar="URL", help="stream to a Rerun viewer or gRPC proxy already running "
+                     "at URL, e.g. rerun+http://127.0.0.1:9876/proxy")
     run.add_argument("--no-progress", action="store_true", help="no progress bar and no summary table")
 
     plot = commands.add_parser("plot", help="write PNG figures from a results file")
@@ -39,7 +41,8 @@ def _parser() -> argparse.ArgumentParser:
 def _run(args: argparse.Namespace) -> None:
     from .runner import run
 
-    run(args.scene, args.out, progress=not args.no_progress, rrd=args.rrd, view=args.view, resume=args.resume)
+    run(args.scene, args.out, progress=not args.no_progress, rrd=args.rrd, view=args.view,
+        connect=args.connect, resume=args.resume)
 
 
 def _plot(args: argparse.Namespace) -> None:

@@ -63,11 +63,13 @@ def simulator_for(scene: Scene) -> Callable[..., dict]:
 
 
 def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = True,
-        rrd: str | Path | None = None, view: bool = False, resume: bool = False) -> dict[str, Any]:
+        rrd: str | Path | None = None, view: bool = False, connect: str | None = None,
+        resume: bool = False) -> dict[str, Any]:
     """Run a scene and write the results file ``out``; return the run's summary.
 
     ``progress`` shows a bar over simulated time and prints the summary table; ``rrd`` saves a Rerun
-    recording to that file; ``view`` streams to a spawned Rerun viewer. On any error the results file
+    recording to that file; ``view`` streams to a spawned Rerun viewer, ``connect`` to a viewer or
+    gRPC proxy already running at that URL. On any error the results file
     is closed with status "failed: <message>" (every completed snapshot kept) and the error re-raised.
     Checkpoints go into ``out`` every :func:`hfgpu.io.checkpoint.checkpoint_interval` of simulated time.
 
@@ -94,10 +96,10 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     checkpoint = Checkpointer(writer.write_checkpoint, checkpoint_interval(scene), start)
     sinks: list[Any] = [writer]
     try:
-        if rrd is not None or view:
+        if rrd is not None or view or connect is not None:
             from .io.rerun_view import RerunRecorder
 
-            sinks.append(RerunRecorder(scene, rrd=rrd, spawn=view))
+            sinks.append(RerunRecorder(scene, rrd=rrd, spawn=view, connect=connect))
     except BaseException as exc:
         writer.fail(str(exc) or type(exc).__name__)
         raise

@@ -57,10 +57,12 @@ def cell_quads(x: np.ndarray, z: np.ndarray, dx: float, dz: float) -> tuple[np.n
 
 
 class RerunRecorder:
-    """Log the records of a run to Rerun: to the file ``rrd`` and/or a spawned viewer (``spawn``)."""
+    """Log the records of a run to Rerun: to the file ``rrd``, a spawned viewer (``spawn``) and/or a viewer or
+    gRPC proxy already running at ``connect`` (a URL such as "rerun+http://127.0.0.1:9876/proxy", e.g. one
+    started with ``rerun --serve-grpc`` on another machine)."""
 
     def __init__(self, scene: Any, *, rrd: str | Path | None = None, spawn: bool = False,
-                 application_id: str = "hfgpu"):
+                 connect: str | None = None, application_id: str = "hfgpu"):
         import rerun as rr
 
         self._rr = rr
@@ -72,10 +74,12 @@ class RerunRecorder:
             except Exception as exc:  # the viewer executable is missing or cannot start
                 raise HfgpuError(f"cannot start the Rerun viewer (--view): {exc}") from None
             sinks.append(rr.GrpcSink())
+        if connect is not None:
+            sinks.append(rr.GrpcSink(connect))
         if rrd is not None:
             sinks.append(rr.FileSink(str(rrd)))
         if not sinks:
-            raise HfgpuError("RerunRecorder needs an .rrd file or spawn=True")
+            raise HfgpuError("RerunRecorder needs an .rrd file, spawn=True or a connect URL")
         self.rec.set_sinks(*sinks)
         self.rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
         for path, name in _SERIES.items():
