@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -79,8 +81,9 @@ def test_live_stream_reaches_a_running_viewer(tmp_path):
     if rerun_exe is None:
         pytest.skip("the rerun executable (rerun-sdk) is not on PATH")
     port, saved = _free_port(), tmp_path / "live.rrd"
+    # its own process group: the `rerun` script starts the viewer binary as a child, both must go at the end
     proxy = subprocess.Popen([rerun_exe, "--serve-grpc", "--port", str(port), "--save", str(saved)],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     try:
         deadline = time.monotonic() + 30.0
         while True:  # wait for the proxy to listen
@@ -104,7 +107,7 @@ def test_live_stream_reaches_a_running_viewer(tmp_path):
                 except Exception:  # a chunk still being written
                     rows = {}
     finally:
-        proxy.terminate()
+        os.killpg(proxy.pid, signal.SIGTERM)
         proxy.wait(timeout=10)
     np.testing.assert_allclose(rows["/world/fracture"], [2.5, 5.0, 7.5, 10.0], rtol=1e-9)
     assert len(rows["/fracture/injected_volume"]) == 40
