@@ -29,6 +29,9 @@ class FractureNumerics:
         cross it (its parent's crossing time, Eq. 34), so leak-off follows the wetted part of the cell.
     max_front_advance: the most the sub-grid front may move in one step, in cells; a longer step is redone
         with half the time step, so results do not depend on how far apart output times are.
+    leakoff_clock: a cell whose leak-off the positivity ramp held below Carter's demand continues from the
+        exposure time its leaked volume corresponds to (leakoff.carter_demand), so time spent dry does not
+        count as exposure; off: Carter's law from the opening time, whatever the cell leaked.
     """
 
     time_step_relaxation: float = BALANCED.time_step_relaxation
@@ -44,6 +47,7 @@ class FractureNumerics:
     tip_velocity: str = "front"
     partial_tip_cells: bool = True
     max_front_advance: float = 1.0
+    leakoff_clock: bool = True
 
 
 def parse_fracture_numerics(t: Table, preset: Preset = BALANCED) -> FractureNumerics:
@@ -67,6 +71,7 @@ def parse_fracture_numerics(t: Table, preset: Preset = BALANCED) -> FractureNume
         tip_velocity=t.choice("tip_velocity", ("fluid", "front"), d.tip_velocity),
         partial_tip_cells=t.boolean("partial_tip_cells", d.partial_tip_cells),
         max_front_advance=t.number("max_front_advance", d.max_front_advance, minimum=0.1, maximum=10.0),
+        leakoff_clock=t.boolean("leakoff_clock", d.leakoff_clock),
     )
     t.finish()
     return numerics

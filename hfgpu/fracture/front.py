@@ -13,7 +13,8 @@ the s^(1/2) profile of constant-DD tip elements, not for the s^(2/3) viscous one
 the tip element's inner face towards the candidate cell (at the tip, fluid and front move together), or
 with ``tip_velocity = "front"`` at least the mean front speed h / (t - t_reached) through the tip element.
 Leak-off needs no extra rule: a new cell's Carter demand keeps it nearly empty until the inflow exceeds it
-(with ``partial_tip_cells`` the demand follows the wetted part of the cell, see simulator.py). Opened cells
+(with ``partial_tip_cells`` the demand follows the wetted part of the cell, and with ``leakoff_clock`` the
+time a cell stays dry does not count as Carter exposure, see simulator.py). Opened cells
 never close, so the front cannot retreat.
 
 Sub-grid front. The same asymptote, inverted at the cells on the fracture's edge, locates the front

@@ -25,7 +25,13 @@ exactly, so the balance holds across the merge, and the active-cell count stays 
 
 Partially filled tip cells (``partial_tip_cells``). A newly opened cell records, besides its opening time,
 the time the front will have crossed it (its parent's crossing time, Eq. 34); its Carter leak-off is the
-exact average over opening times spread uniformly between the two (leakoff.carter_volume).
+exact average over opening times spread uniformly between the two (leakoff.carter_cumulative).
+
+Leak-off clock (``leakoff_clock``). Every cell also records the volume per unit area it has leaked (grid
+field ``leaked``); a cell the positivity ramp held below its Carter demand (opened ahead of the fluid)
+continues from the exposure time that volume corresponds to, not from its opening time
+(leakoff.carter_demand), so the time it spent dry does not count as exposure and the lost demand is
+not lost for good. Coarsening carries it as a volume (sum of the children / 9).
 """
 
 from __future__ import annotations
@@ -42,7 +48,7 @@ from .coarsen import coarsen
 from .config import FractureNumerics
 from .elasticity import ElasticityOperator
 from .front import DIRECTIONS, TipModel, cells_to_open, edge_cells, front_distances
-from .leakoff import carter_volume
+from .leakoff import carter_demand, carter_volume
 from .lubrication import build_faces
 from .mesh import GROW, Grid
 from .newton import Elasticity, StepProblem, solve_step
@@ -140,6 +146,7 @@ class _Engine:
         shape = np.linalg.solve(self.elastic.matrix if self.elastic.matrix is not None
                                 else self.op.dense(self.ix, self.iz), np.ones(self.ix.size))
         g["w"][act] = shape * (injected - leaked.sum()) / (self.area * shape.sum())
+        g["leaked"][act] = leaked / self.area
         self.leaked_total = float(leaked.sum())
         self.t = self.t0
         self.v_front = power * r0 / self.t0
@@ -177,12 +184,16 @@ class _Engine:
         w_old = g["w"][sel]
         tau = g["opened"][sel]
         filled = g["filled"][sel] if self.num.partial_tip_cells else None
+        leaked_old = g["leaked"][sel]
         reach_old = self._front_reach(g["w"], g["p"], self.t)
         h = min(self.dx, self.dz)
         for attempt in range(self.num.max_step_retries + 1):
             source = np.zeros(w_old.size)
             source[self.inj] = self.schedule.mean_rate(self.t, self.t + dt) * dt
-            demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt, filled)
+            if self.num.leakoff_clock:
+                demand = carter_demand(self.cprime_a, tau, leaked_old, self.t, self.t + dt, filled)
+            else:
+                demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt, filled)
             w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
             prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
                                demand, w_eps, 1e-3 * float(w_old.max()))
@@ -207,6 +218,7 @@ class _Engine:
         g["w"][sel] = res.w
         g["p"][sel] = res.p
         g["leak_rate"][sel] = res.leaked / (self.area * dt)
+        g["leaked"][sel] = leaked_old + res.leaked / self.area
         self.leaked_total += float(res.leaked.sum())
         self.v_tip = advance / dt
         self.steps += 1
@@ -266,6 +278,7 @@ class _Engine:
         new["w"][at] = c.width(g["w"][sel])
         new["p"][at] = c.mean(g["p"][sel])
         new["leak_rate"][at] = c.total(g["leak_rate"][sel]) / f**2
+        new["leaked"][at] = c.total(g["leaked"][sel]) / f**2
         new["opened"][at] = c.earliest(g["opened"][sel])
         new["reached"][at] = c.earliest(g["reached"][sel])
         new["filled"][at] = -c.earliest(-g["filled"][sel])
