@@ -10,7 +10,8 @@ particle sub-step; a step whose Courant number comes out above C_max is undone, 
 3. scatter: theta_p at the step's end, so that the fluid's storage term (theta_f w - theta_f^o w^o)/dt of
    Eq. 25 is the change over this very step;
 4. fluid SIMPLE step (Algorithm 1) with theta_f = 1 - theta_p, the interphase force F averaged over the
-   sub-loop, the inlets' fluid sources (1 - c) Q (and the momentum of jet inlets), leak-off and the outlets;
+   sub-loop (its pressure part with each face's own gradient, see pressure_reaction), the inlets' fluid sources
+   (1 - c) Q (and the momentum of jet inlets), leak-off and the outlets;
 5. a :class:`hfgpu.records.SolidBalanceRecord` goes to the sink; snapshots every ``output.every``.
 This is the cycle scatter -> fluid -> particles of the paper entered at the particles: each fluid step sees
 the force of the particle sub-loop over the same interval.
@@ -45,10 +46,10 @@ from ..records import GridFrame, ProppantSnapshot, SolidBalanceRecord
 from .backend import get_backend
 from .config import Geometry, Port, ProppantSetup
 from .fluid import CourantLimitExceeded, FluidNumerics, FluidSolver, FluidState
-from .grid import StaggeredGrid
+from .grid import StaggeredGrid, face_mean
 from .injection import Injector, batch_solid_volume, initial_suspension, ports_to_cells
 from .parcels import Parcels
-from .particle_ops_numpy import ParcelFluid, grid_fields
+from .particle_ops_numpy import GridFields, ParcelFluid, grid_fields
 
 #: fluid volumes [m^3] the fluid step reports (hfgpu.proppant.fluid.StepInfo), summed in fluid_totals
 FLUID_VOLUMES = ("injected", "opened", "supplied", "stored", "leaked", "outflow", "dropped")
@@ -83,6 +84,35 @@ def particles_per_parcel(setup: ProppantSetup, schedule, cell_volume: float) -> 
         ppp = fraction * cell_volume / (numerics.parcels_per_cell * cls.size.mean_particle_volume())
         out.append(ppp if ppp > 0.0 else 1.0)
     return out
+
+
+def drag_only(seen: ParcelFluid) -> ParcelFluid:
+    """``seen`` without the pressure gradient: its exchange (Eq. 39) is the drag part of F only (the pressure
+    part comes from pressure_reaction)."""
+    zero = np.zeros_like(seen.dpdx)
+    return dataclasses.replace(seen, dpdx=zero, dpdz=zero)
+
+
+def pressure_reaction(fields: GridFields) -> tuple[np.ndarray, np.ndarray]:
+    """The pressure part of Eq. 39 on the faces, -sum n V_p grad p I / V_face, with each face's own gradient
+    (the one the fluid feels there) instead of the gradient interpolated at the parcels (Eq. 41): -theta_p,f
+    grad p_f, theta_p,f = (theta_p w)_f / w_f the face mean of Eq. 38's fraction (as the fluid's (theta_f w)_f),
+    so that the fluid feels -grad p + theta_p,f grad p = -theta_f,f grad p (Eq. 8 with Eq. 19) face by face.
+    Why: Eq. 41 spreads a face's gradient over the parcels a cell either side, and Eq. 39 deposits it back on
+    the faces a cell further on; beside a packed inlet, whose gradient is 100-1000 times that of the open
+    fracture next to it, that moved more than the whole local pressure force onto the open faces around it,
+    pushed the fluid towards the high pressure and drove eddies at 3-6 m/s (tests/proppant/test_inlet_speeds.py).
+    The gradient is the old pressure's, the one the parcels feel: taken implicitly (the fluid feeling
+    theta_f grad p^(n+1)), the loop parcels -> continuity -> pressure -> parcels gained theta_p / theta_f per
+    step and oscillated in settling beds above theta_p = 0.5."""
+    is_open = fields.width > 0.0
+    load = fields.volume_fraction * fields.width
+    out = []
+    for axis, gradient in ((1, fields.dpdx), (0, fields.dpdz)):
+        w_f = face_mean(fields.width, is_open, axis)
+        theta = np.divide(face_mean(load, is_open, axis), w_f, out=np.zeros_like(w_f), where=w_f > 0.0)
+        out.append(-theta * gradient)
+    return out[0], out[1]
 
 
 def unit_slip(seen: ParcelFluid, parcels: Parcels) -> ParcelFluid:
@@ -282,7 +312,8 @@ class ProppantSimulation:
 
     def _particle_subloop(self, dt: float, t0: float) -> tuple[np.ndarray, ...]:
         """``particle_substeps`` x (scatter, gather, push, exchange, outlets) in the fluid of the step's start;
-        returns F_x, F_z (Eq. 39) and beta_x, beta_z averaged over the sub-steps."""
+        returns F_x, F_z (Eq. 39: drag_only plus pressure_reaction) and beta_x, beta_z averaged over the
+        sub-steps."""
         n = self.numerics.particle_substeps
         h = dt / n
         frame, width = self.grid.frame, self.grid.width
@@ -295,9 +326,10 @@ class ProppantSimulation:
             seen = self.backend.gather(self.parcels, frame, fields)
             drag = self.backend.push(self.parcels, seen, frame, fields, h, self.params, self.rho_f, self.mu_f,
                                      self.numerics.gravity)
-            force = self.backend.exchange(self.parcels, seen, drag, frame, width)
-            fx += force[0] / n
-            fz += force[1] / n
+            force = self.backend.exchange(self.parcels, drag_only(seen), drag, frame, width)
+            reaction = pressure_reaction(fields)
+            fx += (force[0] + reaction[0]) / n
+            fz += (force[1] + reaction[1]) / n
             beta = self.backend.exchange(self.parcels, unit_slip(seen, self.parcels), drag, frame, width)
             bx += beta[0] / n
             bz += beta[1] / n
