@@ -110,6 +110,22 @@ def proppant_start_time(scene: Scene) -> float:
                      'a coupled run needs a stage with proppant = "<class>" (or set [coupling] proppant_start)')
 
 
+def late_start(scene: Scene, start: float, first: float) -> float:
+    """The proppant start, moved to the fracture's first snapshot ``first`` when that comes later (a coarse grid
+    starts the fracture only once it spans a few cells, hfgpu.fracture.simulator.start_time): nothing is open
+    before it. The slurry pumped in between is not tracked; a warning says how much."""
+    if first <= start:
+        return start
+    schedule = scene.injection.schedule
+    times = np.linspace(start, first, 201)
+    solids = float(np.sum([schedule.rate(t) * schedule.proppant_fraction(t)[1] for t in 0.5 * (times[1:] + times[:-1])])
+                   * (times[1] - times[0]))
+    warnings.warn(f"the fracture fills its first cells at {first:.4g} s, after the proppant start ({start:.4g} s): "
+                  f"the proppant run starts then, and the {solids:.3g} m^3 of solids pumped before are not tracked "
+                  f"(a finer mesh starts the fracture earlier)", RuntimeWarning, stacklevel=3)
+    return first
+
+
 def shifted_schedule(schedule: Schedule, start: float) -> Schedule:
     """The schedule seen from ``start`` on (times minus start; a stage cut at start keeps the loading it has
     there, ramping on to its end value)."""
@@ -283,6 +299,7 @@ def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None =
         fracture = resume["fracture_summary"]
     history = FractureHistory(tee.snapshots)
     timings.seconds["fracture"] += _time.perf_counter() - t0 - timings.seconds["io"]
+    start = late_start(scene, start, float(history.times[0]))
     inj = scene.injection
     frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=(inj.x, inj.depth))
     width0, _, _ = history.fields_at(start, frame, shape)

@@ -146,9 +146,8 @@ class FractureHistory:
 
         Linear in time between the snapshots bracketing t, f = (1 - a) f_k + a f_(k+1),
         a = (t - t_k) / (t_(k+1) - t_k); zero before the first snapshot, the last snapshot after it.
-        open_mask: width > 0. A negative width is set to 0 (closed): the fracture engine has no contact
-        constraint, and cells pinched by a stress barrier can come out negative (down to -0.8 mm in the
-        five-layer demo) or drained by leak-off slightly below 0; leak-off is kept >= 0 and 0 in closed cells.
+        open_mask: width > 0. A negative width (a cell drained by leak-off to round-off below 0; the engine holds
+        contact) is set to 0 (closed); leak-off is kept >= 0 and 0 in closed cells.
         """
         shape = (int(shape[0]), int(shape[1]))
         k = int(np.searchsorted(self.times, t, side="right")) - 1

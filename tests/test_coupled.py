@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from hfgpu import load_scene, open_results, run
-from hfgpu.coupled import (CouplingConfig, proppant_start_time, screen_out_cells, shifted_schedule)
+from hfgpu.coupled import (CouplingConfig, late_start, proppant_start_time, screen_out_cells, shifted_schedule)
 from hfgpu.coupling import FractureHistory
 from hfgpu.errors import SceneError
 from hfgpu.scene import Schedule, Stage
@@ -257,3 +257,12 @@ def test_finer_proppant_props_more_is_less_packed_and_screens_out_less(demo_runs
     assert fine["propped_area"] > coarse["propped_area"]
     assert fine["packed_fraction"] < coarse["packed_fraction"]
     assert fine["screen_out_cells"] <= coarse["screen_out_cells"]
+
+
+def test_proppant_start_waits_for_the_first_fracture_cells():
+    """A fracture that fills its first cells after the pad (coarse grid) moves the proppant start there, with a
+    warning giving the solids pumped in between: 2e-3 m^3/s x 0.1 x 5 s = 1e-3 m^3."""
+    scene = load_scene(TINY)
+    assert late_start(scene, 20.0, 15.0) == 20.0
+    with pytest.warns(RuntimeWarning, match=r"at 25 s.*\(20 s\).*0\.001 m\^3 of solids"):
+        assert late_start(scene, 20.0, 25.0) == 25.0
