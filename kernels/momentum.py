@@ -1,14 +1,16 @@
 """Taichi kernel of the fluid momentum predictor (the paper, Eq. 26 / 49 with Eq. 62-65 and Eq. 9).
 
 Same arithmetic, conventions and signature as the NumPy reference :mod:`hfgpu.proppant.momentum` (read its
-module docstring): one thread per face control volume; the z component runs the x kernel on the transposed
-grid. Inputs and outputs are NumPy float64 arrays.
+module docstring, also for the wall-friction factor f_t of "dean"): one thread per face control volume; the z
+component runs the x kernel on the transposed grid. Inputs and outputs are NumPy float64 arrays.
 """
 
 
 import numpy as np
 
 from hfgpu.kernels.runtime import init, ti
+from hfgpu.proppant.momentum import DEAN_COEFFICIENT
+from hfgpu.proppant.params import WALL_FRICTION_LAWS
 
 F64_2D = ti.types.ndarray(dtype=ti.f64, ndim=2)
 
@@ -35,9 +37,9 @@ def _old_q(width0: ti.template(), theta_f0: ti.template(), k, i):
 @ti.kernel
 def predict_x(u0: F64_2D, v0: F64_2D, p: F64_2D, width0: F64_2D, theta_f0: F64_2D, width: F64_2D,
               theta_f: F64_2D, mu: F64_2D, force_x: F64_2D, rho: ti.f64, dx: ti.f64, dz: ti.f64, dt: ti.f64,
-              u_star: F64_2D, d: F64_2D):
+              dean: ti.i32, u_star: F64_2D, d: F64_2D):
     """u* and d on the x-faces (Eq. 49 with Eq. 62-65, friction Eq. 9 and the u_P flux coefficients
-    point-implicit); walls and closed faces get 0."""
+    point-implicit; dean = 1: Eq. 9 times Dean's f_t); walls and closed faces get 0."""
     nz, nx = width.shape[0], width.shape[1]
     for k, i in ti.ndrange(nz, nx + 1):
         us, dd = 0.0, 0.0
@@ -80,7 +82,12 @@ def predict_x(u0: F64_2D, v0: F64_2D, p: F64_2D, width0: F64_2D, theta_f0: F64_2
                     else:
                         diag += c[0]
                         nb += c[1] * u0[top + 1, i]
-            a = q_f + dt / (dx * dz) * diag + dt * 12.0 * mu_f / (rho * w_f)
+            f_t = 1.0
+            if dean == 1:
+                v_f = 0.25 * (v0[k, i - 1] + v0[k, i] + v0[k + 1, i - 1] + v0[k + 1, i])
+                re = rho * ti.sqrt(u0[k, i] ** 2 + v_f ** 2) * w_f / mu_f
+                f_t = ti.max(1.0, DEAN_COEFFICIENT / 12.0 * re ** 0.75)
+            a = q_f + dt / (dx * dz) * diag + dt * 12.0 * mu_f * f_t / (rho * w_f)
             drive = w_f * (-(p[k, i] - p[k, i - 1]) / (rho * dx) - force_x[k, i] / rho)
             us = (q0_f * u0[k, i] + dt / (dx * dz) * nb + dt * drive) / a
             dd = dt * w_f / (rho * dx * a)
@@ -91,16 +98,20 @@ def predict_x(u0: F64_2D, v0: F64_2D, p: F64_2D, width0: F64_2D, theta_f0: F64_2
 def momentum_predictor(u0: np.ndarray, v0: np.ndarray, p: np.ndarray, width0: np.ndarray,
                        theta_f0: np.ndarray, width: np.ndarray, theta_f: np.ndarray, mu: np.ndarray,
                        force_x: np.ndarray, force_z: np.ndarray, rho: float, dx: float, dz: float,
-                       dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                       dt: float, wall_friction: str = "laminar"
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Momentum predictor, Eq. 26 / 49, on Taichi; same arguments and results as
     :func:`hfgpu.proppant.momentum.momentum_predictor`."""
+    if wall_friction not in WALL_FRICTION_LAWS:
+        raise ValueError(f"wall_friction {wall_friction!r} is not one of {WALL_FRICTION_LAWS}")
+    dean = int(wall_friction == "dean")
     init()
     nz, nx = width.shape
     c = np.ascontiguousarray
     u_star, d_u = np.zeros((nz, nx + 1)), np.zeros((nz, nx + 1))
     v_star_t, d_v_t = np.zeros((nx, nz + 1)), np.zeros((nx, nz + 1))
     predict_x(c(u0), c(v0), c(p), c(width0), c(theta_f0), c(width), c(theta_f), c(mu), c(force_x),
-              rho, dx, dz, dt, u_star, d_u)
+              rho, dx, dz, dt, dean, u_star, d_u)
     predict_x(c(v0.T), c(u0.T), c(p.T), c(width0.T), c(theta_f0.T), c(width.T), c(theta_f.T), c(mu.T),
-              c(force_z.T), rho, dz, dx, dt, v_star_t, d_v_t)
+              c(force_z.T), rho, dz, dx, dt, dean, v_star_t, d_v_t)
     return u_star, v_star_t.T.copy(), d_u, d_v_t.T.copy()

@@ -71,12 +71,13 @@ class NumpyBackend:
     def momentum_predictor(self, u0: np.ndarray, v0: np.ndarray, p: np.ndarray, width0: np.ndarray,
                            theta_f0: np.ndarray, width: np.ndarray, theta_f: np.ndarray, mu: np.ndarray,
                            force_x: np.ndarray, force_z: np.ndarray, rho: float, dx: float, dz: float,
-                           dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                           dt: float, wall_friction: str = "laminar"
+                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Fluid momentum predictor, Eq. 26 / 49 (:func:`hfgpu.proppant.momentum.momentum_predictor`)."""
         from .momentum import momentum_predictor
 
         return momentum_predictor(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, force_z,
-                                        rho, dx, dz, dt)
+                                        rho, dx, dz, dt, wall_friction)
 
 
 class TaichiBackend:
@@ -222,12 +223,13 @@ class TaichiBackend:
     def momentum_predictor(self, u0: np.ndarray, v0: np.ndarray, p: np.ndarray, width0: np.ndarray,
                            theta_f0: np.ndarray, width: np.ndarray, theta_f: np.ndarray, mu: np.ndarray,
                            force_x: np.ndarray, force_z: np.ndarray, rho: float, dx: float, dz: float,
-                           dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                           dt: float, wall_friction: str = "laminar"
+                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Fluid momentum predictor, Eq. 26 / 49, as a Taichi kernel (:mod:`hfgpu.kernels.momentum`)."""
         from ..kernels.momentum import momentum_predictor
 
         return momentum_predictor(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, force_z,
-                                        rho, dx, dz, dt)
+                                        rho, dx, dz, dt, wall_friction)
 
 
 def get_backend(name: str = "taichi", arch: str | None = None) -> NumpyBackend | TaichiBackend:

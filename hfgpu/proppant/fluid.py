@@ -143,11 +143,13 @@ class FluidSolver:
     ``momentum_predictor`` of the signature of :func:`hfgpu.proppant.momentum.momentum_predictor` (the
     backends of :mod:`hfgpu.proppant.backend`); default the NumPy reference. ``params``
     (:class:`hfgpu.proppant.params.MppicParams`): when given, the slurry viscosity mu_f(theta_p) of Eq. 10
-    (:func:`hfgpu.proppant.closures.slurry_viscosity`) is used, else mu_0 everywhere.
+    (:func:`hfgpu.proppant.closures.slurry_viscosity`) is used, else mu_0 everywhere. ``wall_friction``: the
+    predictor's wall-friction law, "laminar" (Eq. 9) or "dean" (MppicParams.wall_friction).
     """
 
     def __init__(self, grid: StaggeredGrid, rho_f: float, mu_0: float,
-                 numerics: FluidNumerics = FluidNumerics(), backend=None, params: MppicParams | None = None):
+                 numerics: FluidNumerics = FluidNumerics(), backend=None, params: MppicParams | None = None,
+                 wall_friction: str = "laminar"):
         for name, value in (("fluid.density", rho_f), ("fluid.viscosity", mu_0)):
             if not (np.isfinite(value) and value > 0.0):
                 raise SceneError(name, value, "must be finite and > 0")
@@ -155,6 +157,7 @@ class FluidSolver:
         self.mu_0 = float(mu_0)
         self.numerics = numerics
         self.params = params
+        self.wall_friction = wall_friction
         self._linear = _CorrectionSolver(numerics.linear_rtol, numerics.reuse_iterations)
         self.backend = numpy_momentum if backend is None else backend
         self.set_grid(grid)
@@ -294,7 +297,7 @@ class FluidSolver:
         for iteration in range(1, self.numerics.max_iterations + 1):
             u, v, d_u, d_v = self.backend.momentum_predictor(
                 state.u, state.v, p, state.width, state.theta_f, grid.width, theta_f, mu,
-                force_x, force_z, self.rho_f, dx, dz, dt)
+                force_x, force_z, self.rho_f, dx, dz, dt, self.wall_friction)
             if drag_x is not None:  # both given (see the checks above)
                 u, d_u = _implicit_drag(u, d_u, state.u, drag_x, dx)
                 v, d_v = _implicit_drag(v, d_v, state.v, drag_z, dz)

@@ -7,11 +7,20 @@ convection-diffusion flux through each of its four faces is Eq. 62-65,
 
 with the power-law scheme A(|P|) = max(0, (1 - 0.1|P|)^5), Peclet number P = F/D, F and D from the old
 velocities (Eq. 50-57). The predicted velocity solves Eq. 49 with the wall friction of Eq. 9 (F_w =
-12 mu_f u/(rho_f w^2), opposing the flow):
+12 mu_f u/(rho_f w^2) f_t, opposing the flow):
 
     a_P u*_P = (theta_f^o w^o)_P u^o_P + dt/(dx dz) sum_nb c_nb u^o_nb
                + dt w_P ( (p_W - p_E)/(rho_f dx) - F_x/rho_f ),
-    a_P = (theta_f w)_P + dt/(dx dz) sum_faces c_P + dt 12 mu_f,P / (rho_f w_P).
+    a_P = (theta_f w)_P + dt/(dx dz) sum_faces c_P + dt 12 mu_f,P f_t,P / (rho_f w_P).
+
+f_t (:func:`wall_friction_factor`) is 1 for the laminar friction of Eq. 9 (wall_friction = "laminar"); for
+"dean" it carries the friction past the laminar-turbulent transition of the flow between the fracture faces:
+Dean's (1978, J. Fluids Eng. 100, 215) skin friction of smooth plane-channel flow, c_f = tau_w / (rho_f U^2/2)
+= 0.073 Re^(-1/4) with Re = rho_f |U| w / mu_f (bulk velocity, full gap), gives the gap-averaged friction per
+unit volume 2 tau_w / w = c_f rho_f |U| U / w; the laminar c_f = 12/Re gives Eq. 9, so the two laws are Eq. 9
+times f_t = max(1, c_f Re / 12) = max(1, (0.073/12) Re^(3/4)) (they cross at Re = (12/0.073)^(4/3) = 899).
+|U| = (u^2 + v^2)^(1/2) is the old speed at the face (v on an x-face: the mean of its four v-faces), so f_t is
+lagged and the friction stays point-implicit.
 
 Two terms are taken at the new level, point-implicitly (no linear system): the friction, and the u_P
 coefficients c_P of the fluxes. Why: explicitly the friction limits the step to dt < rho_f w^2/(12 mu_f)
@@ -36,6 +45,9 @@ from __future__ import annotations
 import numpy as np
 
 from .grid import face_mean
+from .params import WALL_FRICTION_LAWS
+
+DEAN_COEFFICIENT = 0.073  # c_f = 0.073 Re^(-1/4), Dean (1978)
 
 
 def face_coefficients(conductance: np.ndarray, mass_flux: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -48,7 +60,18 @@ def face_coefficients(conductance: np.ndarray, mass_flux: np.ndarray) -> tuple[n
     return da + np.maximum(mass_flux, 0.0), da + np.maximum(-mass_flux, 0.0)
 
 
-def _predict_x(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, rho, dx, dz, dt):
+def wall_friction_factor(speed: np.ndarray, width: np.ndarray, mu: np.ndarray, rho: float,
+                         law: str) -> np.ndarray:
+    """f_t, the wall friction over the laminar 12 mu |U| / w^2 of Eq. 9 (module docstring): 1 for "laminar";
+    max(1, (0.073/12) Re^(3/4)), Re = rho |U| w / mu, for "dean" (Dean 1978, c_f = 0.073 Re^(-1/4))."""
+    if law not in WALL_FRICTION_LAWS:
+        raise ValueError(f"wall_friction {law!r} is not one of {WALL_FRICTION_LAWS}")
+    if law == "laminar":
+        return np.ones(np.broadcast(speed, width, mu).shape)
+    return np.maximum(1.0, DEAN_COEFFICIENT / 12.0 * (rho * speed * width / mu) ** 0.75)
+
+
+def _predict_x(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, rho, dx, dz, dt, wall_friction):
     """u* and d on the x-faces (Eq. 49 with Eq. 62-65 and Eq. 9); see the module docstring."""
     nz, nx = width.shape
     open0, open1 = width0 > 0.0, width > 0.0
@@ -79,7 +102,9 @@ def _predict_x(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, rho, dx
         diag[:-1] += cl_z     # south face of rows ..nz-2 (P above the corner)
         nb[1:] += cl_z * u_in[:-1]
         nb[:-1] += cr_z * u_in[1:]
-    a = q_f + dt / (dx * dz) * diag + dt * 12.0 * mu_f / (rho * w_f)
+    v_f = 0.25 * (v0[:-1, :-1] + v0[:-1, 1:] + v0[1:, :-1] + v0[1:, 1:])  # v at the x-faces
+    f_t = wall_friction_factor(np.sqrt(u0[:, 1:-1] ** 2 + v_f ** 2), w_f, mu_f, rho, wall_friction)
+    a = q_f + dt / (dx * dz) * diag + dt * 12.0 * mu_f * f_t / (rho * w_f)
     drive = w_f * (-(p[:, 1:] - p[:, :-1]) / (rho * dx) - force_x[:, 1:-1] / rho)
     rhs = q0_f * u0[:, 1:-1] + dt / (dx * dz) * nb + dt * drive
     safe_a = np.where(face, a, 1.0)
@@ -93,17 +118,20 @@ def _predict_x(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, rho, dx
 def momentum_predictor(u0: np.ndarray, v0: np.ndarray, p: np.ndarray, width0: np.ndarray,
                        theta_f0: np.ndarray, width: np.ndarray, theta_f: np.ndarray, mu: np.ndarray,
                        force_x: np.ndarray, force_z: np.ndarray, rho: float, dx: float, dz: float,
-                       dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                       dt: float, wall_friction: str = "laminar"
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Momentum predictor, Eq. 26 / 49 (NumPy reference of ``kernels/momentum.py``).
 
     u0 (nz, nx+1), v0 (nz+1, nx): old face velocities [m/s]; p (nz, nx): guessed dynamic pressure p* [Pa];
     width0/theta_f0 and width/theta_f (nz, nx): old and new width [m] and fluid volume fraction; mu (nz, nx):
     slurry viscosity [Pa s] (Eq. 10); force_x (nz, nx+1), force_z (nz+1, nx): interphase force F on the
-    faces [N/m^3] (Eq. 8, acting on the fluid as -F); rho: fluid density [kg/m^3].
+    faces [N/m^3] (Eq. 8, acting on the fluid as -F); rho: fluid density [kg/m^3]; wall_friction: "laminar"
+    (Eq. 9) or "dean" (Eq. 9 times f_t past the transition, module docstring).
     Returns (u*, v*, d_u, d_v): predicted face velocities and pressure-correction coefficients
     [m^3 s/kg]; 0 on walls and closed faces.
     """
-    u_star, d_u = _predict_x(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, rho, dx, dz, dt)
+    u_star, d_u = _predict_x(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, rho, dx, dz, dt,
+                             wall_friction)
     v_star_t, d_v_t = _predict_x(v0.T, u0.T, p.T, width0.T, theta_f0.T, width.T, theta_f.T, mu.T,
-                                 force_z.T, rho, dz, dx, dt)
+                                 force_z.T, rho, dz, dx, dt, wall_friction)
     return u_star, v_star_t.T.copy(), d_u, d_v_t.T.copy()

@@ -8,6 +8,7 @@ from ..errors import SceneError
 
 DRAG_LAWS = ("wen-yu", "snider")
 VISCOSITY_LAWS = ("power", "krieger-dougherty")
+WALL_FRICTION_LAWS = ("laminar", "dean")
 
 
 @dataclass(frozen=True)
@@ -45,6 +46,10 @@ class MppicParams:
     (+z) is >= this (a contact network), and also where it lies on a floor (within one diameter of a closed
     cell or the grid edge below it); default 0.5, the onset of frictional stress of Johnson & Jackson (1987)
     (MFIX EPS_F_MIN = 0.5). Suspended parcels in a dilute suspension never feel it.
+    wall_friction: the fluid's friction on the fracture faces: "laminar" = Eq. 9, 12 mu_f u/(rho_f w^2);
+    "dean" = Eq. 9 times max(1, (0.073/12) Re^(3/4)), Re = rho_f |u| w / mu_f, Dean's (1978) turbulent skin
+    friction of smooth plane-channel flow, c_f = 0.073 Re^(-1/4), past the crossing of the two laws at
+    Re = 899 (identical to "laminar" below it; hfgpu.proppant.momentum).
     """
 
     theta_cp: float = 0.6
@@ -64,6 +69,7 @@ class MppicParams:
     damping_threshold: float = 0.5
     bed_friction: float = 0.543
     friction_volume_fraction: float = 0.5
+    wall_friction: str = "laminar"
 
     def __post_init__(self) -> None:
         def bad(name: str, allowed: str) -> SceneError:
@@ -84,6 +90,8 @@ class MppicParams:
             raise bad("drag_law", f"allowed: one of {list(DRAG_LAWS)}")
         if self.viscosity_law not in VISCOSITY_LAWS:
             raise bad("viscosity_law", f"allowed: one of {list(VISCOSITY_LAWS)}")
+        if self.wall_friction not in WALL_FRICTION_LAWS:
+            raise bad("wall_friction", f"allowed: one of {list(WALL_FRICTION_LAWS)}")
         if not self.viscosity_exponent < 0.0:
             raise bad("viscosity_exponent", "allowed: a number < 0 (viscosity grows with theta_p)")
         if not self.max_relative_viscosity >= 1.0:

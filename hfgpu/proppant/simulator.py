@@ -182,7 +182,8 @@ class ProppantSimulation:
                                   FluidNumerics(c_max=n.c_max, tolerance=n.simple_tolerance,
                                                 max_iterations=n.simple_max_iterations),
                                   self.backend,
-                                  params=self.params if n.slurry_viscosity else None)
+                                  params=self.params if n.slurry_viscosity else None,
+                                  wall_friction=self.params.wall_friction)
         self.fluid = self.solver.initial_state(self._fluid_theta_p())
         self.steps = 0
         self.safety = 1.0

@@ -21,10 +21,15 @@ def random_fields(rng, nz, nx, closed_fraction):
                 force_z=rng.normal(0.0, 50.0, (nz + 1, nx)), rho=1030.0, dx=0.013, dz=0.007, dt=3e-3)
 
 
+@pytest.mark.parametrize("wall_friction", ["laminar", "dean"])
 @pytest.mark.parametrize("nz, nx, closed", [(9, 13, 0.0), (17, 11, 0.25), (1, 7, 0.1), (6, 1, 0.0)])
-def test_kernel_matches_numpy(nz, nx, closed):
+def test_kernel_matches_numpy(nz, nx, closed, wall_friction):
     rng = np.random.default_rng(nz * 100 + nx)
     fields = random_fields(rng, nz, nx, closed)
+    if wall_friction == "dean":
+        # gap Reynolds numbers rho |U| w / mu from ~1 to ~1e4: both branches of max(1, 0.073 Re^0.75 / 12)
+        fields["mu"] = np.exp(rng.uniform(np.log(1e-4), np.log(1e-2), (nz, nx)))
+        fields["wall_friction"] = "dean"
     # cell Peclet numbers span both branches of the power law (|P| < 10 and A = 0 beyond)
     expected = reference(**fields)
     got = get_backend("taichi", arch="cpu").momentum_predictor(**fields)
