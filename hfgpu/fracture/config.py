@@ -18,8 +18,9 @@ class FractureNumerics:
     newton_max_iterations: Newton iterations per step before the step is retried with half the time step.
     max_step_retries: halvings of a failed step before the run stops with a SimulationError.
     initial_radius_cells: radius of the starting radial fracture, in cells (see front.initial_fracture).
-    tip_asymptote: "olson" (Eq. 33, toughness only: 0.806 w = K'/E' s^1/2) or "km" (the larger of the
-        toughness and viscosity (M-vertex) tip asymptotes, see front.py) used for front advance.
+    tip_asymptote: "olson" (Eq. 33, toughness only: 0.806 w = K'/E' s^1/2), "km" (the larger of the
+        toughness and viscosity (M-vertex) tip asymptotes, see front.py) or "universal" (Dontsov & Peirce's
+        2015 universal K-M-M~ asymptote with leak-off, tip_universal.py) used for front advance.
     leakoff_width_fraction: width scale of the leak-off positivity ramp (leakoff.available_fraction) as a
         fraction of the step's Carter demand; a cell never leaks fluid it does not hold.
     max_step_growth: largest ratio of one time step to the previous one.
@@ -64,7 +65,7 @@ def parse_fracture_numerics(t: Table, preset: Preset = BALANCED) -> FractureNume
         max_step_retries=t.integer("max_step_retries", d.max_step_retries, minimum=0),
         initial_radius_cells=t.number("initial_radius_cells", d.initial_radius_cells, minimum=1.0,
                                       maximum=50.0),
-        tip_asymptote=t.choice("tip_asymptote", ("olson", "km"), d.tip_asymptote),
+        tip_asymptote=t.choice("tip_asymptote", ("olson", "km", "universal"), d.tip_asymptote),
         leakoff_width_fraction=t.number("leakoff_width_fraction", d.leakoff_width_fraction, minimum=0.0,
                                         maximum=1.0, exclusive_minimum=True),
         max_step_growth=t.number("max_step_growth", d.max_step_growth, minimum=1.0, maximum=10.0),

@@ -9,7 +9,11 @@ growth), so the default ``tip_asymptote = "km"`` uses the larger of the toughnes
 viscosity (M-vertex) asymptote of Desroches et al. (1994), w = beta_m (mu' V / E')^(1/3) s^(2/3),
 beta_m = 2^(1/3) 3^(5/6) (REFERENCE.md 1.3): a cheap envelope of the universal K-M asymptote of Dontsov &
 Peirce (2015), exact at both ends. Olson's 0.806 multiplies the toughness term only: it was derived for
-the s^(1/2) profile of constant-DD tip elements, not for the s^(2/3) viscous one. V is the fluid velocity through
+the s^(1/2) profile of constant-DD tip elements, not for the s^(2/3) viscous one. ``tip_asymptote =
+"universal"`` uses that universal asymptote itself (tip_universal.py), with Carter's leak-off C' = 2 C_L of
+the tip element as a third process (K, M and M~ vertices and the transitions between them) and the same
+Olson correction of the toughness (K'/0.806 in place of K'), so it equals "km" at the K and M vertices and
+is wider in between (docs/presets.md has the measurements). V is the fluid velocity through
 the tip element's inner face towards the candidate cell (at the tip, fluid and front move together), or
 with ``tip_velocity = "front"`` at least the mean front speed h / (t - t_reached) through the tip element.
 Leak-off needs no extra rule: a new cell's Carter demand keeps it nearly empty until the inflow exceeds it
@@ -33,8 +37,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import tip_universal
+from .tip_universal import BETA_M
+
 OLSON = 0.806
-BETA_M = 2.0 ** (1.0 / 3.0) * 3.0 ** (5.0 / 6.0)
 
 # (row shift, column shift) of the four neighbours: +x, -x, +z, -z.
 DIRECTIONS = ((0, 1), (0, -1), (1, 0), (-1, 0))
@@ -47,22 +53,31 @@ class TipModel:
 
     e_prime: float
     mu_prime: float
-    mode: str  # "olson" or "km"
+    mode: str  # "olson", "km" or "universal"
     velocity: str = "fluid"  # "fluid" or "front" (see tip_velocity)
 
 
-def tip_width(model: TipModel, k_prime: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
+def tip_width(model: TipModel, k_prime: np.ndarray, c_prime: np.ndarray, s: np.ndarray,
+              v: np.ndarray) -> np.ndarray:
     """Cell width that puts the front at distance s: Eq. 33, 0.806 w = K'/E' s^(1/2), or with "km" the
-    larger of that and w = beta_m (mu' V / E')^(1/3) s^(2/3) (M-vertex asymptote)."""
+    larger of that and w = beta_m (mu' V / E')^(1/3) s^(2/3) (M-vertex asymptote), or with "universal" the
+    universal asymptote of K'/0.806, mu' V and C' (tip_universal.width)."""
+    if model.mode == "universal":
+        return tip_universal.width(s, model.e_prime, k_prime / OLSON, c_prime, model.mu_prime,
+                                   np.maximum(v, 0.0))
     w = k_prime / model.e_prime * np.sqrt(s) / OLSON
     if model.mode == "km":
         w = np.maximum(w, BETA_M * np.cbrt(model.mu_prime * np.maximum(v, 0.0) / model.e_prime) * s ** (2 / 3))
     return w
 
 
-def invert_tip(model: TipModel, k_prime: np.ndarray, w: np.ndarray, v: np.ndarray) -> np.ndarray:
+def invert_tip(model: TipModel, k_prime: np.ndarray, c_prime: np.ndarray, w: np.ndarray,
+               v: np.ndarray) -> np.ndarray:
     """Distance s from a cell centre to the front implied by its width w: the inverse of ``tip_width``."""
     w = np.maximum(w, 0.0)
+    if model.mode == "universal":
+        return tip_universal.distance(w, model.e_prime, k_prime / OLSON, c_prime, model.mu_prime,
+                                      np.maximum(v, 0.0))
     with np.errstate(divide="ignore"):
         s = np.where(k_prime > 0.0, (OLSON * w * model.e_prime / np.where(k_prime > 0, k_prime, 1.0)) ** 2,
                      np.inf)
@@ -103,20 +118,45 @@ def inflow_velocity(active: np.ndarray, w: np.ndarray, p: np.ndarray, h: float, 
     return np.where(both, np.maximum(v, 0.0), 0.0)
 
 
+def _tip_cells(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndarray, reached: np.ndarray, t: float,
+               dx: float, dz: float, box_edge: bool) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """For each of DIRECTIONS, the active cells whose neighbour on that side is inactive (or, with
+    ``box_edge``, outside the box); and, over all of them in that order, the distance h/2 from their centre
+    to that face and the tip velocity V of ``tip_velocity`` through their opposite face (one asymptote
+    evaluation for the four directions)."""
+    masks, half, vel = [], [], []
+    for dk, di in DIRECTIONS:
+        h = dz if dk else dx
+        mask = active & ~_shift(active, -dk, -di, not box_edge)
+        v = tip_velocity(model, inflow_velocity(active, w, p, h, dk, di, model.mu_prime), h, t, reached)
+        masks.append(mask)
+        half.append(np.full(int(mask.sum()), 0.5 * h))
+        vel.append(v[mask])
+    return masks, np.concatenate(half), np.concatenate(vel)
+
+
+def _per_direction(values: np.ndarray, masks: list[np.ndarray]) -> list[np.ndarray]:
+    """Split values gathered over ``masks`` (in order) back into one array per mask."""
+    return np.split(values, np.cumsum([int(m.sum()) for m in masks])[:-1])
+
+
 def cells_to_open(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndarray, k_prime: np.ndarray,
-                  reached: np.ndarray, t: float, dx: float, dz: float):
+                  c_prime: np.ndarray, reached: np.ndarray, t: float, dx: float, dz: float):
     """Inactive cells whose tip element satisfies the front criterion (Eq. 33) at s = h/2.
 
     Returns a boolean mask of cells to open and their tip speeds V_T = d / (t - t_parent) (Eq. 34), the
     fastest over the triggering parents (NaN where nothing opens). ``reached`` holds the times the front
-    reached each cell.
+    reached each cell; ``k_prime`` and ``c_prime`` are K' and C' at every cell.
     """
+    masks, half, vel = _tip_cells(model, active, w, p, reached, t, dx, dz, box_edge=False)
+    w_tip = tip_width(model, np.concatenate([k_prime[m] for m in masks]),
+                      np.concatenate([c_prime[m] for m in masks]), half, vel)
     to_open = np.zeros_like(active)
     speed = np.full(active.shape, np.nan)
-    for dk, di in DIRECTIONS:
+    for (dk, di), tips, w_dir in zip(DIRECTIONS, masks, _per_direction(w_tip, masks)):
         h = dz if dk else dx
-        v = tip_velocity(model, inflow_velocity(active, w, p, h, dk, di, model.mu_prime), h, t, reached)
-        ok = active & (w >= tip_width(model, k_prime, np.full(w.shape, 0.5 * h), v))
+        ok = np.zeros_like(active)
+        ok[tips] = w[tips] >= w_dir
         # candidate = the cell on the (dk, di) side of a triggering tip element
         cand = _shift(ok, dk, di, False) & ~active
         parent_time = _shift(reached, dk, di, np.nan)
@@ -135,14 +175,17 @@ def edge_cells(active: np.ndarray) -> np.ndarray:
 
 
 def front_distances(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndarray, k_prime: np.ndarray,
-                    reached: np.ndarray, t: float, dx: float, dz: float) -> list[np.ndarray]:
+                    c_prime: np.ndarray, reached: np.ndarray, t: float, dx: float,
+                    dz: float) -> list[np.ndarray]:
     """Sub-grid front position: for each of DIRECTIONS, the distance s from every active cell's centre to the
     front on that side (the inverse of ``tip_width`` at the cell's width, Eq. 33) where the neighbour on that
     side is inactive, NaN elsewhere. V is the tip velocity of ``tip_velocity`` through the opposite face."""
+    masks, _, vel = _tip_cells(model, active, w, p, reached, t, dx, dz, box_edge=True)
+    s_all = invert_tip(model, np.concatenate([k_prime[m] for m in masks]),
+                       np.concatenate([c_prime[m] for m in masks]), np.concatenate([w[m] for m in masks]), vel)
     out = []
-    for dk, di in DIRECTIONS:
-        h = dz if dk else dx
-        facing = active & ~_shift(active, -dk, -di, False)
-        v = tip_velocity(model, inflow_velocity(active, w, p, h, dk, di, model.mu_prime), h, t, reached)
-        out.append(np.where(facing, invert_tip(model, k_prime, w, v), np.nan))
+    for facing, s_dir in zip(masks, _per_direction(s_all, masks)):
+        s = np.full(w.shape, np.nan)
+        s[facing] = s_dir
+        out.append(s)
     return out

@@ -229,7 +229,8 @@ class _Engine:
         """Largest sub-grid front distance s (Eq. 33 inverted, front.front_distances) of every box cell,
         capped at 2 cells; 0 where a cell faces no inactive cell."""
         g = self.grid
-        dist = front_distances(self.tip, g["active"], w, p, self.kprime_box, g["reached"], t, self.dx, self.dz)
+        dist = front_distances(self.tip, g["active"], w, p, self.kprime_box, self.cprime_box, g["reached"], t,
+                               self.dx, self.dz)
         return np.minimum(np.nan_to_num(np.fmax.reduce(dist), nan=0.0), 2.0 * max(self.dx, self.dz))
 
     def _front_advance(self, reach_old: np.ndarray, w: np.ndarray, p: np.ndarray, t: float) -> float:
@@ -243,7 +244,7 @@ class _Engine:
     def _advance_front(self) -> None:
         """Open the cells the front criterion selects (Eq. 33) and record the tip speed (Eq. 34)."""
         g = self.grid
-        to_open, speed = cells_to_open(self.tip, g["active"], g["w"], g["p"], self.kprime_box,
+        to_open, speed = cells_to_open(self.tip, g["active"], g["w"], g["p"], self.kprime_box, self.cprime_box,
                                        g["reached"], self.t, self.dx, self.dz)
         if not to_open.any():
             return
@@ -325,8 +326,8 @@ class _Engine:
         tip asymptote, capped at one cell) and the extents up (-z), down (+z), left (-x), right (+x)."""
         g = self.grid
         xo, zo = g.offsets()
-        dist = front_distances(self.tip, g["active"], g["w"], g["p"], self.kprime_box, g["reached"], self.t,
-                               self.dx, self.dz)
+        dist = front_distances(self.tip, g["active"], g["w"], g["p"], self.kprime_box, self.cprime_box,
+                               g["reached"], self.t, self.dx, self.dz)
         best = np.zeros(xo.shape)
         ext = {}
         for name, (dk, di), s in zip(("right", "left", "down", "up"), DIRECTIONS, dist):
