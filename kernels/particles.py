@@ -30,6 +30,7 @@ device on a GPU, once per call).
 
 from hfgpu.kernels import elementary
 from hfgpu.kernels.runtime import ti
+from hfgpu.proppant.momentum import DEAN_COEFFICIENT
 
 F1 = ti.types.ndarray(dtype=ti.f64, ndim=1)
 F2 = ti.types.ndarray(dtype=ti.f64, ndim=2)
@@ -412,6 +413,30 @@ def on_bed(sx: ti.f64, sz: ti.f64, radius: ti.f64, dz: ti.f64, theta: ti.templat
 
 
 @ti.func
+def deposited(sx: ti.f64, sz: ti.f64, fluid_u: ti.f64, width: ti.f64, radius: ti.f64, rho_p: ti.f64,
+              theta: ti.template(), dense: ti.f64, rho_f: ti.f64, mu: ti.f64, gravity: ti.f64,
+              wall_law: ti.i32) -> ti.i32:
+    """For a parcel on a bed (on_bed): its own cell is loose (theta_p < dense) and the Shields number of the bed
+    shear stress f_t sqrt(12) mu |u_f| / w is below Soulsby & Whitehouse's (1997) critical one
+    (particle_ops_numpy._deposited; closures.bed_shear_stress, critical_shields_number)."""
+    out = 0
+    i = ti.cast(ti.floor(sx + 0.5), ti.i32)
+    k = ti.cast(ti.floor(sz + 0.5), ti.i32)
+    if theta[k, i] < dense:
+        speed = ti.abs(fluid_u)
+        f_t = 1.0
+        if wall_law == 1:
+            f_t = ti.max(1.0, DEAN_COEFFICIENT / 12.0 * (rho_f * speed * width / mu) ** 0.75)
+        tau = f_t * ti.sqrt(12.0) * mu * speed / width
+        d = 2.0 * radius
+        shields = tau / ((rho_p - rho_f) * gravity * d)
+        d_star = d * ti.pow((rho_p / rho_f - 1.0) * gravity / (mu / rho_f) ** 2, 1.0 / 3.0)
+        critical = 0.30 / (1.0 + 1.2 * d_star) + 0.055 * (1.0 - ti.exp(-0.020 * d_star))
+        out = ti.cast(shields < critical, ti.i32)
+    return out
+
+
+@ti.func
 def row(s: ti.template(), j: ti.template()):
     """Row j of a (SEEN, LANES) matrix as a LANES vector."""
     return ti.Vector([s[j, l] for l in ti.static(range(LANES))], dt=ti.f64)
@@ -508,12 +533,14 @@ def push_lanes(p0: ti.i32, n: ti.i32, s: ti.template(), x: ti.template(), z: ti.
                cell_mask: ti.template(), theta_grid: ti.template(), dt: ti.f64, rho_f: ti.f64, mu: ti.f64,
                gravity: ti.f64, theta_cp: ti.f64, epsilon: ti.f64, restitution: ti.f64, law: ti.i32,
                re_coefficient: ti.f64, bridging_factor: ti.f64, iterations: ti.i32, bed_friction: ti.f64,
-               friction_fraction: ti.f64, drag_out: ti.template()):
+               friction_fraction: ti.f64, shields: ti.i32, wall_law: ti.i32, drag_out: ti.template()):
     """Eq. 43-44 in place for the LANES parcels p0, p0 + 1, ... (< n) that see s: velocity_lanes; then per
-    parcel bed friction (on_bed) and bridging (particle_ops_numpy.push), and move."""
+    parcel bed friction (on_bed), the threshold of motion on a bed surface (deposited, where ``shields``) and
+    bridging (particle_ops_numpy.push), and move."""
     un, vn, drag, friction = velocity_lanes(p0, n, u, v, radius, density, s, dt, rho_f, mu, gravity, theta_cp,
                                             epsilon, restitution, law, re_coefficient, iterations, bed_friction)
     seen_width = row(s, SEEN - 1)
+    seen_u = row(s, 0)
     for l in ti.static(range(LANES)):
         if p0 + l < n:
             u[p0 + l] = un[l]
@@ -528,6 +555,10 @@ def push_lanes(p0: ti.i32, n: ti.i32, s: ti.template(), x: ti.template(), z: ti.
             if on_bed(sx, sz, radius[p], dz, theta_grid, width, friction_fraction) > 0.0:
                 speed = ti.max(ti.abs(u[p]) - friction[l], 0.0)
                 u[p] = -speed if u[p] < 0.0 else speed
+                if shields:
+                    if deposited(sx, sz, seen_u[l], seen_width[l], radius[p], density[p], theta_grid,
+                                 friction_fraction, rho_f, mu, gravity, wall_law):
+                        u[p] = 0.0
         state[p] = ti.cast(0, ti.i32)
         if seen_width[l] < bridging_factor * 2.0 * radius[p]:
             u[p] = 0.0
@@ -544,9 +575,10 @@ def push(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, state: I1,
          dt: ti.f64, rho_f: ti.f64, mu: ti.f64, gravity: ti.f64,
          theta_cp: ti.f64, epsilon: ti.f64, restitution: ti.f64, law: ti.i32, re_coefficient: ti.f64,
          bridging_factor: ti.f64, iterations: ti.i32, bed_friction: ti.f64, friction_fraction: ti.f64,
-         drag_out: F1):
+         shields: ti.i32, wall_law: ti.i32, drag_out: F1):
     """Eq. 43-44 in place with what the parcels see (s_*, the rows of ParcelFluid); D_p into drag_out; flags of
-    stencil_flags. One task per LANES parcels (push_lanes)."""
+    stencil_flags; shields: MppicParams.shields_deposition (0/1), wall_law: its wall_friction_code. One task
+    per LANES parcels (push_lanes)."""
     n = ti.cast(x.shape[0], ti.i32)
     for q in range(ti.cast((n + LANES - 1) // LANES, ti.i32)):
         p0 = ti.cast(q * LANES, ti.i32)
@@ -555,7 +587,7 @@ def push(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, state: I1,
                                              s_mean_v, s_damping, s_width))], dt=ti.f64)
         push_lanes(p0, n, s, x, z, u, v, radius, density, state, x0, z0, dx, dz, flags, width, cell_mask,
                    theta_grid, dt, rho_f, mu, gravity, theta_cp, epsilon, restitution, law, re_coefficient,
-                   bridging_factor, iterations, bed_friction, friction_fraction, drag_out)
+                   bridging_factor, iterations, bed_friction, friction_fraction, shields, wall_law, drag_out)
 
 
 @ti.func

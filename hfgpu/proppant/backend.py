@@ -200,7 +200,8 @@ class TaichiBackend:
         """The closure constants the push kernel takes, in its order."""
         return (params.theta_cp, params.epsilon, params.packing_restitution, params.drag_law_code,
                 params.drag_re_coefficient, params.bridging_factor, params.drag_iterations,
-                params.bed_friction, params.friction_volume_fraction)
+                params.bed_friction, params.friction_volume_fraction, int(params.shields_deposition),
+                params.wall_friction_code)
 
     def exchange(self, parcels: Parcels, seen: ParcelFluid, drag: np.ndarray, frame: GridFrame,
                  width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

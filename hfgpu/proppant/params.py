@@ -50,6 +50,12 @@ class MppicParams:
     "dean" = Eq. 9 times max(1, (0.073/12) Re^(3/4)), Re = rho_f |u| w / mu_f, Dean's (1978) turbulent skin
     friction of smooth plane-channel flow, c_f = 0.073 Re^(-1/4), past the crossing of the two laws at
     Re = 899 (identical to "laminar" below it; hfgpu.proppant.momentum).
+    shields_deposition: threshold of motion on the bed surface (push, particle_ops_numpy._deposited): a
+    parcel resting on a bed surface (on a floor, or above a dense cell, its own cell loose; _on_bed) stops along
+    the bed (x velocity 0) while the Shields number of the bed shear stress of the fluid it sees is below the
+    critical one: tau_b / ((rho_p - rho_f) g d) < theta_cr (Shields 1936; theta_cr of Soulsby & Whitehouse
+    1997; tau_b = f_t sqrt(12) mu_o |u_f| / w, the surface stress of the gap-averaged flow, closures); above
+    it the grain is entrained and only bed friction slows it. Default false (docs/proppant-closures.md).
     """
 
     theta_cp: float = 0.6
@@ -70,6 +76,7 @@ class MppicParams:
     bed_friction: float = 0.543
     friction_volume_fraction: float = 0.5
     wall_friction: str = "laminar"
+    shields_deposition: bool = False
 
     def __post_init__(self) -> None:
         def bad(name: str, allowed: str) -> SceneError:
@@ -99,8 +106,9 @@ class MppicParams:
         if isinstance(self.drag_iterations, bool) or not isinstance(self.drag_iterations, int) \
                 or self.drag_iterations < 1:
             raise bad("drag_iterations", "allowed: an integer >= 1")
-        if not isinstance(self.damping, bool):
-            raise bad("damping", "allowed: true or false")
+        for name in ("damping", "shields_deposition"):
+            if not isinstance(getattr(self, name), bool):
+                raise bad(name, "allowed: true or false")
         if not 0.0 <= self.damping_threshold <= 1.0:
             raise bad("damping_threshold", "allowed: 0 <= damping_threshold <= 1")
         if not 0.0 < self.friction_volume_fraction < 1.0:
@@ -110,3 +118,8 @@ class MppicParams:
     def drag_law_code(self) -> int:
         """Integer code of the drag law for kernels: 0 wen-yu (Eq. 14), 1 snider."""
         return DRAG_LAWS.index(self.drag_law)
+
+    @property
+    def wall_friction_code(self) -> int:
+        """Integer code of the wall-friction law for kernels: 0 laminar (Eq. 9), 1 dean."""
+        return WALL_FRICTION_LAWS.index(self.wall_friction)

@@ -204,6 +204,24 @@ def _bed_friction(u, on_bed, buoyant_g, dt, den, params: MppicParams):
     return np.where(on_bed, np.copysign(slide, u), u)
 
 
+def _deposited(x, z, on_bed, seen: ParcelFluid, radius, rho_p, frame: GridFrame, fields: GridFields,
+               params: MppicParams, fluid_density, fluid_viscosity, gravity) -> np.ndarray:
+    """True where a parcel rests on a bed surface below the threshold of motion (shields_deposition): on a
+    bed (_on_bed) with its own cell loose (theta_p < friction_volume_fraction: a grain on the floor or on top
+    of a dense cell, not inside the bed) and a Shields number of the bed shear stress of the fluid velocity
+    along the bed it sees below the critical one, tau_b / ((rho_p - rho_f) g 2r) < theta_cr
+    (closures.bed_shear_stress, closures.critical_shields_number)."""
+    if not params.shields_deposition:
+        return np.zeros(x.shape, dtype=bool)
+    k, i, _ = owning_cell(x, z, frame, fields.width.shape)
+    surface = on_bed & (fields.volume_fraction[k, i] < params.friction_volume_fraction)
+    width = np.where(surface, seen.width, 1.0)
+    tau = closures.bed_shear_stress(seen.fluid_u, width, fluid_density, fluid_viscosity, params.wall_friction)
+    shields = closures.shields_number(tau, 2.0 * radius, rho_p, fluid_density, gravity)
+    return surface & (shields < closures.critical_shields_number(2.0 * radius, rho_p, fluid_density,
+                                                                 fluid_viscosity, gravity))
+
+
 def _blocked(x, z, x_try, z_try, frame: GridFrame, fields: GridFields, params: MppicParams) -> np.ndarray:
     """True where the move (x, z) -> (x_try, z_try) leaves the grid, enters a closed cell, raises the
     bilinear weight (Eq. 37) of the parcel on a cell whose theta_p (Eq. 38, this step's scatter) is already
@@ -254,7 +272,8 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     that arrives together against a wall; the cap bounds every cell's theta_p by theta_cp plus one step's
     inflow, whatever the parcels' velocities.
     Bed friction: where the parcel rests in or on a dense bed or on the floor (_on_bed) its x velocity is
-    reduced by Coulomb friction (_bed_friction, mu_b = bed_friction) before the walls.
+    reduced by Coulomb friction (_bed_friction, mu_b = bed_friction) before the walls; with
+    shields_deposition, one on a bed surface below the threshold of motion (_deposited) stops along x.
     Bridging: where the width of the parcel's cell is below bridging_factor x 2 r the parcel is set to state 1
     with zero velocity and does not move; others get state 0. Gravity [m/s^2] acts along +z (depth).
     """
@@ -277,6 +296,8 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
                                              params.packing_restitution)
     on_bed = _on_bed(parcels.x, parcels.z, parcels.radius, frame, fields, params)
     u_new = _bed_friction(u_new, on_bed, buoyant_g, dt, den, params)
+    u_new = np.where(_deposited(parcels.x, parcels.z, on_bed, seen, parcels.radius, rho_p, frame, fields, params,
+                                fluid_density, fluid_viscosity, gravity), 0.0, u_new)
     bridged = seen.width < params.bridging_factor * 2.0 * parcels.radius
     u_new = np.where(bridged, 0.0, u_new)
     v_new = np.where(bridged, 0.0, v_new)

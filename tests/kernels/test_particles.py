@@ -64,17 +64,25 @@ def run_step(backend, frame, width, parcels, fluid, params, dt=2e-3):
     return moments, seen, drag, forces
 
 
-@pytest.mark.parametrize("drag_law, sort, theta_cp", [("wen-yu", False, 0.6), ("snider", False, 0.6),
-                                                      ("wen-yu", True, 0.6), ("wen-yu", True, 0.045)])
-def test_taichi_matches_numpy(taichi_backend, numpy_backend, drag_law, sort, theta_cp):
+@pytest.mark.parametrize("drag_law, sort, theta_cp, shields", [
+    ("wen-yu", False, 0.6, None), ("snider", False, 0.6, None), ("wen-yu", True, 0.6, None),
+    ("wen-yu", True, 0.045, None), ("wen-yu", True, 0.6, "laminar"), ("wen-yu", False, 0.6, "dean")])
+def test_taichi_matches_numpy(taichi_backend, numpy_backend, drag_law, sort, theta_cp, shields):
     """Random order (every parcel flushes its own deposit) and sorted by cell (runs summed locally); with
     theta_cp = 0.045 about half of the cells count as packed, so the packing cap of the push acts, and
-    friction_volume_fraction = 0.03 puts many parcels on a "bed", so bed friction stops some and slows others."""
+    friction_volume_fraction = 0.03 puts many parcels on a "bed", so bed friction stops some and slows others.
+    ``shields``: shields_deposition on with that wall-friction law, friction_volume_fraction 0.035 (about half
+    the cells dense: many parcels on a bed surface) and fluid velocities x 8 (gap Re up to ~2000), so that
+    some surface parcels are below the threshold of motion and some above."""
     frame, width, parcels, fluid = random_case()
     if sort:
         parcels.sort_by_cell(frame, width.shape)
+    fraction = 0.03 if theta_cp < 0.1 else 0.035 if shields else 0.5
     params = MppicParams(drag_law=drag_law, P_s=100.0, damping_threshold=0.0, theta_cp=theta_cp,
-                         friction_volume_fraction=0.03 if theta_cp < 0.1 else 0.5)
+                         friction_volume_fraction=fraction, shields_deposition=shields is not None,
+                         wall_friction=shields or "laminar")
+    if shields:
+        fluid = {**fluid, "u": 8.0 * fluid["u"]}
     a, b = parcels.copy(), parcels.copy()
     ra = run_step(taichi_backend, frame, width, a, fluid, params)
     rb = run_step(numpy_backend, frame, width, b, fluid, params)
