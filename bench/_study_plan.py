@@ -59,7 +59,7 @@ def sweeps(name: str, quick: bool) -> list[tuple[str, Knobs]]:
         out += [("parcels", Knobs(parcels_per_cell=n)) for n in ((4, 32) if quick else (4, 8, 32, 64))]
         out += [("dt", Knobs(dt_max=dt)) for dt in ((0.5, 8.0) if quick else (0.5, 1.0, 8.0))]
         out += [("substeps", Knobs(particle_substeps=n)) for n in ((1, 16) if quick else (1, 2, 8, 16))]
-    elif name == "field":
+    elif name in ("field", "field_100mesh"):
         counts = (4, 16, 64) if quick else (4, 8, 16, 32, 64)
         seeds = (1, 2, 3) if quick else (1, 2, 3, 4, 5)
         out += [("seeds", Knobs(parcels_per_cell=n, seed=s)) for n in counts for s in seeds]

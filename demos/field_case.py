@@ -32,11 +32,7 @@ def load(scaled: bool, backend: str | None = None, size: str | None = None):
     if backend is not None:
         setup = dataclasses.replace(setup, numerics=dataclasses.replace(setup.numerics, backend=backend))
     if size is not None:
-        from hfgpu.proppant.sieve import make_distribution, sieve_range
-
-        classes = tuple(dataclasses.replace(c, size=make_distribution("normal", *sieve_range(size)), sieve=size)
-                        for c in setup.classes)
-        setup = dataclasses.replace(setup, classes=classes)
+        setup = setup.with_sieve(size)
     return scene.replace(proppant=setup)
 
 

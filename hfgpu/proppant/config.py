@@ -143,6 +143,13 @@ class ProppantSetup:
     def class_index(self, name: str) -> int:
         return [c.name for c in self.classes].index(name)
 
+    def with_sieve(self, size: str) -> "ProppantSetup":
+        """Every class with the sieve class ``size`` ("30/50", "100 mesh", ...; normal distribution over its
+        range), names kept so the schedule still refers to them: the size study's one change."""
+        distribution = make_distribution("normal", *sieve_range(size))
+        return dataclasses.replace(self, classes=tuple(dataclasses.replace(c, size=distribution, sieve=size)
+                                                       for c in self.classes))
+
 
 def parse_proppant_setup(top: Table, run: Any, fluid: Any, mesh: Any) -> ProppantSetup:
     """Read ``[geometry]``, ``[[proppant]]`` and ``[mppic]`` from the scene's top table."""
