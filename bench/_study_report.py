@@ -186,8 +186,12 @@ def pareto_figure(runs: list[Run], path: Path) -> None:
     """Error against CPU seconds, log-log, one panel per case; Pareto front as a line, presets labelled."""
     by_case = _by_case(runs)
     n = len(by_case)
-    fig, axes = plt.subplots(1, n, figsize=(4.2 * n, 3.9), squeeze=False)
-    for ax, (case, rows) in zip(axes[0], by_case.items()):
+    cols = min(n, 3)
+    rows_ = -(-n // cols)
+    fig, axes = plt.subplots(rows_, cols, figsize=(4.6 * cols, 3.9 * rows_), squeeze=False)
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    for ax, (case, rows) in zip(axes.flat, by_case.items()):
         ok = [r for r in rows if np.isfinite(r.error) and r.error > 0 and np.isfinite(r.cpu)]
         for group in GROUP_STYLE:
             sel = [r for r in ok if r.group == group and group != "preset"]
