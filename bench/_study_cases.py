@@ -286,6 +286,9 @@ CASES = {
                       reference="Kynch + MLB (Davis et al. 1982): max |rel. err| of the two interface speeds"),
     "field": Case("field", "five_layer_demo.toml", _field, _relative_to,
                   reference="most accurate run: max |rel. diff| of fracture area, propped area, propped fraction"),
+    "field_base": Case("field_base", "five_layer.toml", _field, _relative_to,
+                       reference="the 3600 s base case against its run at refinement 1.5 (3.3 m cells) and "
+                                 "relaxation 0.25: max |rel. diff| of fracture area, propped area, propped fraction"),
     "field_100mesh": Case("field_100mesh", "five_layer_demo.toml", _field, _relative_to, sieve="100 mesh",
                           reference="the same with 100 mesh sand (40/70 screens out at the perforation of the "
                                     "scaled demo: its propped area is a few cells)"),
