@@ -263,8 +263,8 @@ def warn_inconsistent_width(summary: dict) -> None:
         warnings.warn(f"the fracture width history on the proppant grid is not mass-consistent with the injection: "
                       f"its open cells needed {supplied:.4g} m^3 of fluid beyond the {injected:.4g} m^3 injected "
                       f"less leak-off ({100 * supplied / injected:+.1f} %; cells that open are filled apart), "
-                      "supplied over the growing cells (known causes: negative fracture widths beside a barrier, "
-                      "closed on the proppant grid; slurry held back by a screen-out)", RuntimeWarning, stacklevel=3)
+                      "supplied over the growing cells (known causes: slurry held back by a screen-out; the "
+                      "width interpolated linearly between fracture snapshots; coarse cells)", RuntimeWarning, stacklevel=3)
 
 
 def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None = None,
