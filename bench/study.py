@@ -40,7 +40,8 @@ def _merge(a: dict | None, b: dict) -> dict:
     if a is None:
         return dict(b)
     return {**a, "cpu_total": a["cpu_total"] + b["cpu_total"], "wall_total": a["wall_total"] + b["wall_total"],
-            "load": (a["load"][0], b["load"][1]), "quick": a["quick"] and b["quick"]}
+            "load": (a["load"][0], b["load"][1]), "quick": a["quick"] and b["quick"],
+            "backend": a["backend"] if a["backend"] == b["backend"] else f"{a['backend']} / {b['backend']}"}
 
 
 def main(argv: list[str] | None = None) -> None:
