@@ -116,10 +116,7 @@ def late_start(scene: Scene, start: float, first: float) -> float:
     before it. The slurry pumped in between is not tracked; a warning says how much."""
     if first <= start:
         return start
-    schedule = scene.injection.schedule
-    times = np.linspace(start, first, 201)
-    solids = float(np.sum([schedule.rate(t) * schedule.proppant_fraction(t)[1] for t in 0.5 * (times[1:] + times[:-1])])
-                   * (times[1] - times[0]))
+    solids = scene.injection.schedule.solid_volume(start, first)
     warnings.warn(f"the fracture fills its first cells at {first:.4g} s, after the proppant start ({start:.4g} s): "
                   f"the proppant run starts then, and the {solids:.3g} m^3 of solids pumped before are not tracked "
                   f"(a finer mesh starts the fracture earlier)", RuntimeWarning, stacklevel=3)

@@ -119,6 +119,11 @@ class Stage:
     volume_fraction: float = 0.0
     end_volume_fraction: float = 0.0
 
+    def fraction_at(self, t: float, start: float) -> float:
+        """Slurry volume fraction at time t of this stage, which began at ``start`` (linear ramp)."""
+        s = (t - start) / (self.until - start)
+        return self.volume_fraction + s * (self.end_volume_fraction - self.volume_fraction)
+
 
 @dataclass(frozen=True)
 class Schedule:
@@ -162,10 +167,18 @@ class Schedule:
         i = self.stage_index(t)
         if i < 0:
             return None, 0.0
-        stage = self.stages[i]
         start = 0.0 if i == 0 else self.stages[i - 1].until
-        s = (t - start) / (stage.until - start)
-        return stage.proppant, stage.volume_fraction + s * (stage.end_volume_fraction - stage.volume_fraction)
+        return self.stages[i].proppant, self.stages[i].fraction_at(t, start)
+
+    def solid_volume(self, t0: float, t1: float) -> float:
+        """Solids pumped over [t0, t1] [m^3]: int Q c dt, exact (Q constant and c linear within a stage)."""
+        total, start = 0.0, 0.0
+        for stage in self.stages:
+            a, b = max(t0, start), min(t1, stage.until)
+            if b > a:
+                total += stage.rate * 0.5 * (stage.fraction_at(a, start) + stage.fraction_at(b, start)) * (b - a)
+            start = stage.until
+        return total
 
 
 @dataclass(frozen=True)

@@ -94,6 +94,10 @@ schedule = [{ until = "60 s", rate = "20 bbl/min" },
 [[proppant]]""", 1)
     schedule = load_scene(text).injection.schedule
     assert schedule.breakpoints() == pytest.approx((60.0, 60.0 + 375.0), rel=1e-12)
+    q = 20 * 0.158987294928 / 60  # 20 bbl/min in m^3/s
+    # solids: Q x mean fraction 0.2 x 375 s over the ramp; the pad carries none; half the ramp: mean 0.15
+    assert schedule.solid_volume(0.0, 1000.0) == pytest.approx(q * 0.2 * 375.0, rel=1e-12)
+    assert schedule.solid_volume(0.0, 60.0 + 187.5) == pytest.approx(q * 0.15 * 187.5, rel=1e-12)
     with pytest.raises(SceneError) as err:
         load_scene(text.replace('clean_volume = "100 bbl"', 'clean_volume = "100 bbl", duration = "5 s"'))
     assert err.value.path == "injection.schedule[1].clean_volume" and "not" in str(err.value)
