@@ -10,7 +10,7 @@ import numpy as np
 
 from hfgpu.kernels.runtime import init, ti
 from hfgpu.proppant.momentum import DEAN_COEFFICIENT
-from hfgpu.proppant.params import WALL_FRICTION_LAWS
+from hfgpu.proppant.params import wall_friction_code
 
 F64_2D = ti.types.ndarray(dtype=ti.f64, ndim=2)
 
@@ -32,6 +32,16 @@ def _old_q(width0: ti.template(), theta_f0: ti.template(), k, i):
     if width0[k, i] > 0.0:
         q = theta_f0[k, i] * width0[k, i]
     return q
+
+
+@ti.func
+def wall_friction_factor(speed: ti.f64, width: ti.f64, mu: ti.f64, rho: ti.f64, dean: ti.i32) -> ti.f64:
+    """f_t of :func:`hfgpu.proppant.momentum.wall_friction_factor`: 1 (laminar, Eq. 9), or with dean = 1
+    max(1, (0.073/12) Re^(3/4)), Re = rho |U| w / mu (Dean 1978)."""
+    f_t = 1.0
+    if dean == 1:
+        f_t = ti.max(1.0, DEAN_COEFFICIENT / 12.0 * (rho * speed * width / mu) ** 0.75)
+    return f_t
 
 
 @ti.kernel
@@ -82,11 +92,8 @@ def predict_x(u0: F64_2D, v0: F64_2D, p: F64_2D, width0: F64_2D, theta_f0: F64_2
                     else:
                         diag += c[0]
                         nb += c[1] * u0[top + 1, i]
-            f_t = 1.0
-            if dean == 1:
-                v_f = 0.25 * (v0[k, i - 1] + v0[k, i] + v0[k + 1, i - 1] + v0[k + 1, i])
-                re = rho * ti.sqrt(u0[k, i] ** 2 + v_f ** 2) * w_f / mu_f
-                f_t = ti.max(1.0, DEAN_COEFFICIENT / 12.0 * re ** 0.75)
+            v_f = 0.25 * (v0[k, i - 1] + v0[k, i] + v0[k + 1, i - 1] + v0[k + 1, i])
+            f_t = wall_friction_factor(ti.sqrt(u0[k, i] ** 2 + v_f ** 2), w_f, mu_f, rho, dean)
             a = q_f + dt / (dx * dz) * diag + dt * 12.0 * mu_f * f_t / (rho * w_f)
             drive = w_f * (-(p[k, i] - p[k, i - 1]) / (rho * dx) - force_x[k, i] / rho)
             us = (q0_f * u0[k, i] + dt / (dx * dz) * nb + dt * drive) / a
@@ -102,9 +109,7 @@ def momentum_predictor(u0: np.ndarray, v0: np.ndarray, p: np.ndarray, width0: np
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Momentum predictor, Eq. 26 / 49, on Taichi; same arguments and results as
     :func:`hfgpu.proppant.momentum.momentum_predictor`."""
-    if wall_friction not in WALL_FRICTION_LAWS:
-        raise ValueError(f"wall_friction {wall_friction!r} is not one of {WALL_FRICTION_LAWS}")
-    dean = int(wall_friction == "dean")
+    dean = wall_friction_code(wall_friction)
     init()
     nz, nx = width.shape
     c = np.ascontiguousarray

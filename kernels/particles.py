@@ -29,8 +29,8 @@ device on a GPU, once per call).
 """
 
 from hfgpu.kernels import elementary
+from hfgpu.kernels.momentum import wall_friction_factor
 from hfgpu.kernels.runtime import ti
-from hfgpu.proppant.momentum import DEAN_COEFFICIENT
 
 F1 = ti.types.ndarray(dtype=ti.f64, ndim=1)
 F2 = ti.types.ndarray(dtype=ti.f64, ndim=2)
@@ -424,10 +424,7 @@ def deposited(sx: ti.f64, sz: ti.f64, fluid_u: ti.f64, width: ti.f64, radius: ti
     k = ti.cast(ti.floor(sz + 0.5), ti.i32)
     if theta[k, i] < dense:
         speed = ti.abs(fluid_u)
-        f_t = 1.0
-        if wall_law == 1:
-            f_t = ti.max(1.0, DEAN_COEFFICIENT / 12.0 * (rho_f * speed * width / mu) ** 0.75)
-        tau = f_t * ti.sqrt(12.0) * mu * speed / width
+        tau = wall_friction_factor(speed, width, mu, rho_f, wall_law) * ti.sqrt(12.0) * mu * speed / width
         d = 2.0 * radius
         shields = tau / ((rho_p - rho_f) * gravity * d)
         d_star = d * ti.pow((rho_p / rho_f - 1.0) * gravity / (mu / rho_f) ** 2, 1.0 / 3.0)

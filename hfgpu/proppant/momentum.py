@@ -45,7 +45,7 @@ from __future__ import annotations
 import numpy as np
 
 from .grid import face_mean
-from .params import WALL_FRICTION_LAWS
+from .params import wall_friction_code
 
 DEAN_COEFFICIENT = 0.073  # c_f = 0.073 Re^(-1/4), Dean (1978)
 
@@ -64,9 +64,7 @@ def wall_friction_factor(speed: np.ndarray, width: np.ndarray, mu: np.ndarray, r
                          law: str) -> np.ndarray:
     """f_t, the wall friction over the laminar 12 mu |U| / w^2 of Eq. 9 (module docstring): 1 for "laminar";
     max(1, (0.073/12) Re^(3/4)), Re = rho |U| w / mu, for "dean" (Dean 1978, c_f = 0.073 Re^(-1/4))."""
-    if law not in WALL_FRICTION_LAWS:
-        raise ValueError(f"wall_friction {law!r} is not one of {WALL_FRICTION_LAWS}")
-    if law == "laminar":
+    if wall_friction_code(law) == 0:
         return np.ones(np.broadcast(speed, width, mu).shape)
     return np.maximum(1.0, DEAN_COEFFICIENT / 12.0 * (rho * speed * width / mu) ** 0.75)
 

@@ -11,6 +11,13 @@ VISCOSITY_LAWS = ("power", "krieger-dougherty")
 WALL_FRICTION_LAWS = ("laminar", "dean")
 
 
+def wall_friction_code(law: str) -> int:
+    """Integer code of a wall-friction law for kernels: 0 laminar (Eq. 9), 1 dean; ValueError for other names."""
+    if law not in WALL_FRICTION_LAWS:
+        raise ValueError(f"wall_friction {law!r} is not one of {WALL_FRICTION_LAWS}")
+    return WALL_FRICTION_LAWS.index(law)
+
+
 @dataclass(frozen=True)
 class MppicParams:
     """Frozen MP-PIC closure constants; checked on construction (SceneError names ``mppic.<field>``).
@@ -121,5 +128,5 @@ class MppicParams:
 
     @property
     def wall_friction_code(self) -> int:
-        """Integer code of the wall-friction law for kernels: 0 laminar (Eq. 9), 1 dean."""
-        return WALL_FRICTION_LAWS.index(self.wall_friction)
+        """Integer code of the wall-friction law for kernels (:func:`wall_friction_code`)."""
+        return wall_friction_code(self.wall_friction)
