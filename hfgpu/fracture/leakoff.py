@@ -62,6 +62,11 @@ def exposure_time(c_prime: np.ndarray, leaked: np.ndarray, span: np.ndarray) -> 
     return u
 
 
+def _span(tau: np.ndarray, filled: np.ndarray | None) -> np.ndarray:
+    """Time the front takes to cross each cell (partially filled tip cells: filled - tau, >= 0); 0 without."""
+    return np.zeros_like(tau) if filled is None else np.maximum(np.asarray(filled, dtype=float) - tau, 0.0)
+
+
 def carter_volume(c_prime: np.ndarray, tau: np.ndarray, t0: float, t1: float,
                   filled: np.ndarray | None = None) -> np.ndarray:
     """Leaked volume per unit area over [t0, t1]: 2 C' (sqrt(t1 - tau) - sqrt(max(t0, tau) - tau)) (Eq. 29).
@@ -71,7 +76,7 @@ def carter_volume(c_prime: np.ndarray, tau: np.ndarray, t0: float, t1: float,
     is the exact average of Eq. 29's integral over it (:func:`carter_cumulative`).
     """
     tau = np.asarray(tau, dtype=float)
-    span = np.zeros_like(tau) if filled is None else np.maximum(np.asarray(filled, dtype=float) - tau, 0.0)
+    span = _span(tau, filled)
     return np.where(t1 > tau, carter_cumulative(c_prime, t1 - tau, span)
                     - carter_cumulative(c_prime, np.maximum(t0, tau) - tau, span), 0.0)
 
@@ -83,7 +88,7 @@ def carter_demand(c_prime: np.ndarray, tau: np.ndarray, leaked: np.ndarray, t0: 
     u0 = min(t0 - tau, exposure_time(leaked)) and V_L = :func:`carter_cumulative`; equal to
     :func:`carter_volume` for a cell that leaked its full demand so far."""
     c_prime, tau, leaked = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (c_prime, tau, leaked)))
-    span = np.zeros_like(tau) if filled is None else np.maximum(np.asarray(filled, dtype=float) - tau, 0.0)
+    span = _span(tau, filled)
     elapsed = np.maximum(t0 - tau, 0.0)
     u0 = elapsed.copy()
     short = leaked < carter_cumulative(c_prime, elapsed, span)   # the ramp held some demand back (C' > 0)
