@@ -274,6 +274,9 @@ class Case:
         return apply_knobs(scene, knobs, self.refine_x)
 
 
+#: The field cases (errors against their most accurate run); those with a parcel-count and seed sweep.
+FIELD_CASES = ("field", "field_100mesh")
+
 CASES = {
     "radial_I": Case("radial_I", "radial_I.toml", _radial, _radial_error,
                      reference="Dontsov (2016): max(|R err|, |w(0) err|) at 370 s"),

@@ -7,7 +7,7 @@ import dataclasses
 import tomllib
 
 
-from _study_cases import CASES, PRESETS, SCENES, Case, Knobs, Run, run_case, score
+from _study_cases import CASES, FIELD_CASES, PRESETS, SCENES, Case, Knobs, Run, run_case, score
 
 COLUMNS = ("case", "group", "setting", "cells", "parcels", "steps", "cpu_s", "wall_s", "error")
 #: (case, preset) pairs the quick study leaves out for their cost (Wu 2008 on 3 mm cells: thousands of elements).
@@ -62,7 +62,7 @@ def sweeps(name: str, quick: bool) -> list[tuple[str, Knobs]]:
         out += [("parcels", Knobs(parcels_per_cell=n)) for n in ((4, 32) if quick else (4, 8, 32, 64))]
         out += [("dt", Knobs(dt_max=dt)) for dt in ((0.5, 8.0) if quick else (0.5, 1.0, 8.0))]
         out += [("substeps", Knobs(particle_substeps=n)) for n in ((1, 16) if quick else (1, 2, 8, 16))]
-    elif name in ("field", "field_100mesh"):
+    elif name in FIELD_CASES:
         counts = (4, 16, 64) if quick else (4, 8, 16, 32, 64)
         seeds = (1, 2, 3) if quick else (1, 2, 3, 4, 5)
         out += [("seeds", Knobs(parcels_per_cell=n, seed=s)) for n in counts for s in seeds]

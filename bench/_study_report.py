@@ -13,7 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from _study_cases import CASES, PRESET_KNOBS, PRESETS, SCENES, Run, load_scene  # noqa: E402
+from _study_cases import CASES, FIELD_CASES, PRESET_KNOBS, PRESETS, SCENES, Run, load_scene  # noqa: E402
 from _study_plan import QUICK_SKIP  # noqa: E402
 
 GROUP_STYLE = {"preset": ("k", "*"), "space": ("tab:blue", "o"), "time": ("tab:orange", "s"),
@@ -86,10 +86,6 @@ def convergence(runs: list[Run], case: str, group: str) -> dict:
         out["self_order"][part] = fitted_order(h[:-1], (q[:-1] - q[-1]) / q[-1]) if len(sel) > 2 else math.nan
         out["monotone"][part] = bool(np.all(np.diff(np.abs(err)) <= 0.0) and np.all(np.sign(err) == np.sign(err[0])))
     return out
-
-
-#: The field cases with a parcel-count and seed study.
-FIELD_CASES = ("field", "field_100mesh")
 
 
 def parcel_study(runs: list[Run], case: str) -> list[dict]:

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import tip_universal
-from .tip_universal import BETA_M
+from .tip_universal import m_scale
 
 OLSON = 0.806
 
@@ -67,7 +67,7 @@ def tip_width(model: TipModel, k_prime: np.ndarray, c_prime: np.ndarray, s: np.n
                                    np.maximum(v, 0.0))
     w = k_prime / model.e_prime * np.sqrt(s) / OLSON
     if model.mode == "km":
-        w = np.maximum(w, BETA_M * np.cbrt(model.mu_prime * np.maximum(v, 0.0) / model.e_prime) * s ** (2 / 3))
+        w = np.maximum(w, m_scale(model.e_prime, model.mu_prime, np.maximum(v, 0.0)) * s ** (2 / 3))
     return w
 
 
@@ -82,7 +82,7 @@ def invert_tip(model: TipModel, k_prime: np.ndarray, c_prime: np.ndarray, w: np.
         s = np.where(k_prime > 0.0, (OLSON * w * model.e_prime / np.where(k_prime > 0, k_prime, 1.0)) ** 2,
                      np.inf)
         if model.mode == "km":
-            scale = BETA_M * np.cbrt(model.mu_prime * np.maximum(v, 0.0) / model.e_prime)
+            scale = m_scale(model.e_prime, model.mu_prime, np.maximum(v, 0.0))
             s = np.minimum(s, np.where(scale > 0.0, (w / np.where(scale > 0, scale, 1.0)) ** 1.5, np.inf))
     return s
 

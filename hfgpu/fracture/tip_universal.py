@@ -40,6 +40,11 @@ ITERATIONS = 100
 RTOL = 1e-10
 
 
+def m_scale(e_prime, mu_prime, v):
+    """beta_m (mu' V / E')^(1/3): the M-vertex width is m_scale s^(2/3) (Desroches et al. 1994)."""
+    return BETA_M * np.cbrt(mu_prime * v / e_prime)
+
+
 def _bracket(k: np.ndarray, c: np.ndarray) -> np.ndarray:
     """The bracket of f, 1 - K^3 - 3/2 C (1 - K^2) + 3 C^2 (1 - K) - 3 C^3 ln((C + 1)/(C + K)), for
     0 <= K <= 1, C >= 0. For C > SERIES_FROM it is summed as its convergent expansion in y = 1/C,
@@ -73,11 +78,18 @@ def _c2(d: np.ndarray) -> np.ndarray:
     return 16.0 * (1.0 - 3.0 * safe) / (3.0 * safe * (2.0 - 3.0 * safe)) * np.tan(1.5 * np.pi * safe)
 
 
+def delta(k_hat: np.ndarray, c_hat: np.ndarray) -> np.ndarray:
+    """The local tip exponent delta(K^, C^) = (beta_m^3/3) (1 + b0 C^) g0, g0 = f(K^, b0 C^, beta_m^3/3), in
+    [0, 1/3] (w ~ s^((1 + delta)/2); Dontsov 2016, Dontsov & Peirce 2017)."""
+    k_hat = np.clip(k_hat, 0.0, 1.0)
+    g0 = _bracket(k_hat, B0 * c_hat) / (3.0 * C1_M)
+    return np.clip(C1_M * (1.0 + B0 * c_hat) * g0, 0.0, 1.0 / 3.0)
+
+
 def g_delta(k_hat: np.ndarray, c_hat: np.ndarray) -> np.ndarray:
     """s^ = g_delta(K^, C^) of Dontsov & Peirce (2015), with delta from the zero-order solution."""
     k_hat = np.clip(k_hat, 0.0, 1.0)
-    g0 = _bracket(k_hat, B0 * c_hat) / (3.0 * C1_M)
-    d = np.clip(C1_M * (1.0 + B0 * c_hat) * g0, 0.0, 1.0 / 3.0)
+    d = delta(k_hat, c_hat)
     c1 = _c1(d)
     return _bracket(k_hat, _c2(d) / c1 * c_hat) / (3.0 * c1)
 
@@ -94,7 +106,7 @@ def _residual(w, s, e_prime, k_prime, c_prime, mu_prime, v):
 def _vertex_widths(s, e_prime, k_prime, c_prime, mu_prime, v):
     """K, M and M~ vertex widths at s (their maximum is a lower bound of the universal width)."""
     w_k = k_prime / e_prime * np.sqrt(s)
-    w_m = BETA_M * np.cbrt(mu_prime * v / e_prime) * s ** (2.0 / 3.0)
+    w_m = m_scale(e_prime, mu_prime, v) * s ** (2.0 / 3.0)
     w_mt = BETA_MT * (2.0 * c_prime * mu_prime / e_prime) ** 0.25 * v**0.125 * s**0.625
     return np.maximum(np.maximum(w_k, w_m), w_mt)
 
@@ -154,7 +166,7 @@ def distance(w, e_prime, k_prime, c_prime, mu_prime, v) -> np.ndarray:
         args = (e_prime, k_prime[moving], c_prime[moving], mu_prime, v[moving])
         wm = w[moving]
         vm, cm = v[moving], c_prime[moving]
-        hi = np.minimum(s[moving], (wm / (BETA_M * np.cbrt(mu_prime * vm / e_prime))) ** 1.5)
+        hi = np.minimum(s[moving], (wm / m_scale(e_prime, mu_prime, vm)) ** 1.5)
         with np.errstate(divide="ignore"):
             hi = np.minimum(hi, (wm / (BETA_MT * (2.0 * cm * mu_prime / e_prime) ** 0.25 * vm**0.125)) ** 1.6)
         s[moving] = _solve(lambda x: _residual(wm, x, *args), hi / 9.0, hi)

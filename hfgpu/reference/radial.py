@@ -22,6 +22,7 @@ import numpy as np
 from scipy.special import beta as beta_fn
 from scipy.special import betainc
 
+from ..fracture.tip_universal import delta, g_delta
 from .checks import non_negative, positive
 
 
@@ -268,45 +269,8 @@ def regime(E_prime, K_prime, mu_prime, C_prime, Q0, t):
 # ------------------------------------------------------------------------------------------------------------
 # Dontsov (2016) universal approximate solution (REFERENCE.md 1.3)
 
-_BETA_M = 2.0 ** (1.0 / 3.0) * 3.0 ** (5.0 / 6.0)
-_BETA_MT = 4.0 / (15.0**0.25 * (np.sqrt(2.0) - 1.0) ** 0.25)
-_B0 = 3.0 * _BETA_MT**4 / (4.0 * _BETA_M**3)          # 0.9912
-
-
-_F_SERIES_N = np.arange(4, 34)
-
-
-def _f(K, C, C1):
-    """Tip-asymptote integral f(K, C; C1) (Dontsov 2016, after Dontsov & Peirce 2015):
-
-    [1 - K^3 - 3/2 C (1 - K^2) + 3 C^2 (1 - K) - 6 C^3 artanh((1 - K)/(2C + 1 + K))] / (3 C1).
-    Since 2 artanh((1-K)/(2C+1+K)) = ln(1 + 1/C) - ln(1 + K/C), expanding the logarithms gives the exact series
-    sum_{n>=4} (-1)^n (1 - K^n) / (n C^{n-3}) / C1 (its first three terms are Dontsov's large-C form); it is
-    used for C > 10 (30 terms), where the closed form loses digits to cancellation.
-    """
-    Cd = np.minimum(C, 10.0)
-    closed = (1.0 - K**3 - 1.5 * Cd * (1.0 - K**2) + 3.0 * Cd**2 * (1.0 - K)
-              - 3.0 * Cd**3 * np.log((1.0 + Cd) / (K + Cd))) / 3.0
-    n = _F_SERIES_N
-    Cs = np.maximum(C, 10.0)[..., None]
-    series = np.sum((-1.0) ** n * (1.0 - K[..., None] ** n) / (n * Cs ** (n - 3)), axis=-1)
-    return np.where(C > 10.0, series, closed) / C1
-
-
-def _delta(K, C):
-    """Tip exponent Delta(K, C) = (beta_m^3/3) f(K, b0 C; beta_m^3/3) (1 + b0 C) (Dontsov 2016),
-    clipped to [1e-6, 1/3 - 1e-6]."""
-    d = _BETA_M**3 / 3.0 * _f(K, _B0 * C, _BETA_M**3 / 3.0) * (1.0 + _B0 * C)
-    return np.clip(d, 1e-6, 1.0 / 3.0 - 1e-6)
-
-
-def _g(K, C):
-    """Tip-asymptote function g_delta(K, C) = f(K, C C2(Delta)/C1(Delta); C1(Delta)) with
-    C1(d) = 4(1-2d)/(d(1-d)) tan(pi d), C2(d) = 16(1-3d)/(3d(2-3d)) tan(3 pi d/2) (Dontsov 2016)."""
-    d = _delta(K, C)
-    c1 = 4.0 * (1.0 - 2.0 * d) / (d * (1.0 - d)) * np.tan(np.pi * d)
-    c2 = 16.0 * (1.0 - 3.0 * d) / (3.0 * d * (2.0 - 3.0 * d)) * np.tan(1.5 * np.pi * d)
-    return _f(K, C * c2 / c1, c1)
+# Tip asymptote g_delta(K, C) and exponent Delta(K, C) (Dontsov & Peirce 2015, Dontsov 2016):
+# hfgpu.fracture.tip_universal.g_delta / delta, the one implementation.
 
 
 def _upper_beta(x, a, b):
@@ -317,7 +281,7 @@ def _upper_beta(x, a, b):
 def _volume_integral(K, C, alpha, lam):
     """B(K, C, alpha; lambda) = 2^{1+delta}[-Bbar(1/2; lambda+1, 2+delta) + Bbar(1/2; lambda+2, 1+delta)]
     + C alpha^{3/2} B(2 alpha, 3/2) (Dontsov 2016, global volume balance); also returns delta."""
-    dlt = 0.5 * (1.0 + _delta(K, C))
+    dlt = 0.5 * (1.0 + delta(K, C))
     storage = 2.0 ** (1.0 + dlt) * (-_upper_beta(0.5, lam + 1.0, 2.0 + dlt) + _upper_beta(0.5, lam + 2.0, 1.0 + dlt))
     leak = C * alpha**1.5 * beta_fn(2.0 * alpha, 1.5)
     return storage + leak, leak, dlt
@@ -342,7 +306,7 @@ def _solve_K(C, a, K_start):
     logaC3 = np.log(a) + 3.0 * np.log(C)
     for _ in range(200):
         K = np.exp(u)
-        g = _g(K, C)
+        g = g_delta(K, C)
         F = np.where(g > 0.0, 6.0 * u - logaC3 - np.log(np.where(g > 0.0, g, 1.0)), np.inf)
         lo = np.where(F < 0.0, u, lo)
         hi = np.where(F >= 0.0, u, hi)
@@ -399,13 +363,13 @@ def dontsov_radial(E_prime, K_prime, mu_prime, C_prime, Q0, t) -> RadialSolution
                     break
             if np.all(np.abs(Kh - K_old) <= 1e-9 * Kh) and np.all(np.abs(Ch - C_old) <= 1e-9 * Ch):
                 break
-        s = _g(Kh, Ch)
+        s = g_delta(Kh, Ch)
         lh = Ch**4 * s**2 / Kh**10
         alpha = np.gradient(np.log(lh), np.log(th))
         alpha[0], alpha[-1] = alpha[1], alpha[-2]
 
     lam, eta, _, dlt = _lambda_and_efficiency(Kh, Ch, alpha)
-    s = _g(Kh, Ch)
+    s = g_delta(Kh, Ch)
     L_star = (Q**3 * E * tmk**4 / mu) ** (1.0 / 9.0)
     eps_star = (mu / (E * tmk)) ** (1.0 / 3.0)
     R = Ch**4 * s**2 / Kh**10 / (16.0 * ph) * L_star
