@@ -165,16 +165,17 @@ def owner_width(sx: ti.f64, sz: ti.f64, width: ti.template()) -> ti.f64:
 
 @ti.func
 def blocked(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, width: ti.template(), cell_mask: ti.template(),
-            theta: ti.template(), theta_cp: ti.f64) -> ti.i32:
-    """The move (sx, sz) -> (sxn, szn) (cell coordinates) leaves the grid, enters a closed cell, or raises the
-    parcel's bilinear weight on a cell with theta_p >= theta_cp (particle_ops_numpy._blocked)."""
+            theta: ti.template(), theta_cp: ti.f64, dense: ti.f64) -> ti.i32:
+    """The move (sx, sz) -> (sxn, szn) (cell coordinates) leaves the grid, enters a closed cell, raises the
+    parcel's bilinear weight on a cell with theta_p >= theta_cp, or heads for a wall from a cell with theta_p >=
+    dense (friction_volume_fraction; particle_ops_numpy._blocked)."""
     out = 1
     if owner_width(sxn, szn, width) > 0.0:
         out = 0
         if packed_near(sxn, szn, theta, theta_cp):
             out = packed_gain(sx, sz, sxn, szn, cell_mask, theta, theta_cp)
         if out == 0:
-            out = toward_wall_packed(sx, sz, sxn, szn, width, theta, theta_cp)
+            out = toward_wall_dense(sx, sz, sxn, szn, width, theta, dense)
     return out
 
 
@@ -188,16 +189,16 @@ def closed(k: ti.i32, i: ti.i32, width: ti.template()) -> ti.i32:
 
 
 @ti.func
-def toward_wall_packed(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, width: ti.template(),
-                       theta: ti.template(), theta_cp: ti.f64) -> ti.i32:
-    """The parcel's own cell is at close packing and it moves, within the half cell next to a wall (domain
-    edge or closed cell), towards that wall (particle_ops_numpy._toward_wall_packed). The sign of the move is
+def toward_wall_dense(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, width: ti.template(),
+                      theta: ti.template(), dense: ti.f64) -> ti.i32:
+    """The parcel's own cell has theta_p >= dense and it moves, within the half cell next to a wall (domain
+    edge or closed cell), towards that wall (particle_ops_numpy._toward_wall_dense). The sign of the move is
     that of sxn - sx: cell coordinates are monotone in x, and differ wherever the move counts."""
     out = 0
     i = ti.cast(ti.floor(sx + 0.5), ti.i32)
     k = ti.cast(ti.floor(sz + 0.5), ti.i32)
     if k >= 0 and k < width.shape[0] and i >= 0 and i < width.shape[1]:
-        if theta[k, i] >= theta_cp:
+        if theta[k, i] >= dense:
             fx = sx - i
             fz = sz - k
             if ti.abs(sxn - i) > ti.abs(fx) and fx * (sxn - sx) > 0.0:
@@ -502,7 +503,7 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, u: ti.template(), v: ti.template(), ra
 @ti.func
 def move(p: ti.i32, sx: ti.f64, sz: ti.f64, flag: ti.i32, x: ti.template(), z: ti.template(), u: ti.template(),
          v: ti.template(), x0: ti.f64, z0: ti.f64, dx: ti.f64, dz: ti.f64, dt: ti.f64, width: ti.template(),
-         cell_mask: ti.template(), theta_grid: ti.template(), theta_cp: ti.f64):
+         cell_mask: ti.template(), theta_grid: ti.template(), theta_cp: ti.f64, dense: ti.f64):
     """Eq. 44 for parcel p at cell coordinates (sx, sz) with its new velocity (u[p], v[p]), x first, then z;
     a move that blocked() stops is cancelled and that velocity component set to 0 (particle_ops_numpy.push).
     A parcel of a QUIET cell (``flag``, stencil_flags) that stays in it is not stopped and skips the checks."""
@@ -512,11 +513,11 @@ def move(p: ti.i32, sx: ti.f64, sz: ti.f64, flag: ti.i32, x: ti.template(), z: t
     szn = (zn - z0) / dz
     stays = ti.floor(sxn + 0.5) == ti.floor(sx + 0.5) and ti.floor(szn + 0.5) == ti.floor(sz + 0.5)
     if not (stays and flag & QUIET):
-        if blocked(sx, sz, sxn, sz, width, cell_mask, theta_grid, theta_cp):
+        if blocked(sx, sz, sxn, sz, width, cell_mask, theta_grid, theta_cp, dense):
             xn = x[p]
             sxn = sx
             u[p] = 0.0
-        if blocked(sxn, sz, sxn, szn, width, cell_mask, theta_grid, theta_cp):
+        if blocked(sxn, sz, sxn, szn, width, cell_mask, theta_grid, theta_cp, dense):
             zn = z[p]
             v[p] = 0.0
     x[p] = xn
@@ -561,7 +562,8 @@ def push_lanes(p0: ti.i32, n: ti.i32, s: ti.template(), x: ti.template(), z: ti.
             u[p] = 0.0
             v[p] = 0.0
             state[p] = ti.cast(1, ti.i32)
-        move(p, sx, sz, flag, x, z, u, v, x0, z0, dx, dz, dt, width, cell_mask, theta_grid, theta_cp)
+        move(p, sx, sz, flag, x, z, u, v, x0, z0, dx, dz, dt, width, cell_mask, theta_grid, theta_cp,
+             friction_fraction)
 
 
 @ti.kernel

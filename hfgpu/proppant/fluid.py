@@ -231,9 +231,10 @@ class FluidSolver:
         force_z (nz+1, nx): interphase force F [N/m^3] on the faces (default 0); sources (nz, nx): fluid
         inflow [m^3/s] per cell; leakoff (nz, nx): s_l [m/s]; outlets (nz, nx) bool: fixed-pressure cells,
         held at ``outlet_pressure`` [Pa] (dynamic pressure; scalar or (nz, nx)). drag_x (nz, nx+1), drag_z
-        (nz+1, nx): optional drag coefficient beta = sum n rho_p V_p D_p I / V_face [kg/(m^3 s)] on the faces;
-        when given, the force is linearised about the old fluid velocity, F = F^o + beta (u - u^o), and the
-        beta part is taken implicitly (see _implicit_drag): explicitly a packed bed's drag limits dt to about
+        (nz+1, nx): optional drag coefficient beta [kg/(m^3 s)] on the faces (the simulator's: sum n rho_p V_p
+        D_p (1 - r_p) I / V_face, less the share r_p the parcels follow, simulator.parcel_response); when
+        given, the force is linearised about the old fluid velocity, F = F^o + beta (u - u^o), and the beta part
+        is taken implicitly (see _implicit_drag): explicitly a packed bed's drag limits dt to about
         2 rho_f theta_f / beta. momentum_x (nz, nx+1), momentum_z (nz+1, nx): optional momentum the inlets' fluid
         carries into each face control volume per unit density [m^4/s^2] (the inlet source of Eq. 8 / 26, e.g.
         :meth:`hfgpu.proppant.injection.Injector.jet_momentum`), added to the face's drive as

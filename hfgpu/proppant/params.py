@@ -52,7 +52,9 @@ class MppicParams:
     friction_volume_fraction: a parcel feels bed friction where theta_p of its own cell or of the cell below it
     (+z) is >= this (a contact network), and also where it lies on a floor (within one diameter of a closed
     cell or the grid edge below it); default 0.5, the onset of frictional stress of Johnson & Jackson (1987)
-    (MFIX EPS_F_MIN = 0.5). Suspended parcels in a dilute suspension never feel it.
+    (MFIX EPS_F_MIN = 0.5). Suspended parcels in a dilute suspension never feel it. The same contact network
+    stops a parcel in the half cell next to a wall from moving towards that wall where its own cell has theta_p
+    >= this (push, particle_ops_numpy._toward_wall_dense: a move there changes no grid field).
     wall_friction: the fluid's friction on the fracture faces: "laminar" = Eq. 9, 12 mu_f u/(rho_f w^2);
     "dean" = Eq. 9 times max(1, (0.073/12) Re^(3/4)), Re = rho_f |u| w / mu_f, Dean's (1978) turbulent skin
     friction of smooth plane-channel flow, c_f = 0.073 Re^(-1/4), past the crossing of the two laws at

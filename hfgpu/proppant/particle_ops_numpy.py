@@ -225,7 +225,7 @@ def _deposited(x, z, on_bed, seen: ParcelFluid, radius, rho_p, frame: GridFrame,
 def _blocked(x, z, x_try, z_try, frame: GridFrame, fields: GridFields, params: MppicParams) -> np.ndarray:
     """True where the move (x, z) -> (x_try, z_try) leaves the grid, enters a closed cell, raises the
     bilinear weight (Eq. 37) of the parcel on a cell whose theta_p (Eq. 38, this step's scatter) is already
-    >= theta_cp (the packing cap of push), or heads for a wall from a packed cell (_toward_wall_packed)."""
+    >= theta_cp (the packing cap of push), or heads for a wall from a dense cell (_toward_wall_dense)."""
     k, i, inside = owning_cell(x_try, z_try, frame, fields.width.shape)
     k0, i0, w0 = weights(x, z, frame, "cell", fields.cell_mask)
     k1, i1, w1 = weights(x_try, z_try, frame, "cell", fields.cell_mask)
@@ -233,16 +233,20 @@ def _blocked(x, z, x_try, z_try, frame: GridFrame, fields: GridFields, params: M
     before = np.sum(w0[:, None, :] * same, axis=2)
     packed = fields.volume_fraction[k1, i1] >= params.theta_cp
     return ~inside | (fields.width[k, i] <= 0.0) | np.any(packed & (w1 > before), axis=1) \
-        | _toward_wall_packed(x, z, x_try, z_try, frame, fields, params)
+        | _toward_wall_dense(x, z, x_try, z_try, frame, fields, params)
 
 
-def _toward_wall_packed(x, z, x_try, z_try, frame: GridFrame, fields: GridFields, params: MppicParams):
+def _toward_wall_dense(x, z, x_try, z_try, frame: GridFrame, fields: GridFields, params: MppicParams):
     """True where a parcel in the half cell next to a wall (domain edge or closed cell) moves towards it while
-    its own cell is at close packing: there the bilinear weights of Eq. 37 no longer change, so the packing cap
-    would not see parcels piling up against the wall (the wall is its mirror image, a cell as packed)."""
+    its own cell is dense, theta_p >= friction_volume_fraction (a contact network, as for bed friction). There
+    the bilinear weights of Eq. 37 no longer change (the wall's node is inactive), so the move changes no grid
+    field: neither the packing cap nor the particle stress (Eq. 16) can see or resist the grains piling up
+    against the wall, and the stress gradient the parcel reads is that of the face on its other side. In a
+    contact network the grains between the parcel and the wall (its mirror image, a cell as dense) carry it;
+    in a loose cell it settles through."""
     nz, nx = fields.width.shape
     k, i, inside = owning_cell(x, z, frame, (nz, nx))
-    packed = inside & (fields.volume_fraction[k, i] >= params.theta_cp)
+    dense = inside & (fields.volume_fraction[k, i] >= params.friction_volume_fraction)
     out = np.zeros(x.shape, dtype=bool)
     for pos, new, origin, step, along_x in ((x, x_try, frame.x0, frame.dx, True),
                                             (z, z_try, frame.z0, frame.dz, False)):
@@ -252,7 +256,7 @@ def _toward_wall_packed(x, z, x_try, z_try, frame: GridFrame, fields: GridFields
         kn, in_ = (k, i + side) if along_x else (k + side, i)
         beyond = (kn < 0) | (kn >= nz) | (in_ < 0) | (in_ >= nx)
         wall = beyond | (fields.width[np.clip(kn, 0, nz - 1), np.clip(in_, 0, nx - 1)] <= 0.0)
-        out |= packed & moves_out & wall
+        out |= dense & moves_out & wall
     return out
 
 
@@ -266,7 +270,7 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     limited per component by Snider (2001) eqs. 39-41 (packing limiter, see _limited_stress_velocity).
     Walls, per component (x first): a move that would leave the grid, enter a closed cell, or raise the
     parcel's bilinear weight on a cell whose theta_p (this step's scatter) is already >= theta_cp, or approach a
-    wall within the half cell next to it when the parcel's own cell is at close packing (_toward_wall_packed),
+    wall within the half cell next to it when the parcel's own cell is dense (_toward_wall_dense),
     is cancelled and that velocity component set to 0 (inelastic stop). The last rule is our packing cap: Snider's limiter
     bounds the velocity relative to the cell's mean parcel velocity, which does not stop a stream of parcels
     that arrives together against a wall; the cap bounds every cell's theta_p by theta_cp plus one step's

@@ -24,8 +24,20 @@ screened_out to round-off; :func:`simulate` ends with a RuntimeWarning line when
 time, volume). A growing fracture can drive the loop through ``width_field(t) -> (width, leakoff)`` on the grid
 (cells that open join the fluid grid; leak-off [m/s per unit area, both faces] is the sink s_l of Eq. 7).
 
-The drag part of F is also handed to the fluid step as beta = sum n rho_p V_p D_p I / V_face, so that the
-fluid takes F = F^o + beta (u_f - u_f^o) implicitly: explicit drag would limit dt to ~2 rho_f theta_f / beta
+The drag part of F is also handed to the fluid step as beta = sum n rho_p V_p D_p (1 - r_p) I / V_face, so
+that the fluid takes F = F^o + beta (u_f - u_f^o) implicitly, r_p being the share of a change of u_f that the
+parcel's own implicit update (Eq. 43) follows within the step (parcel_response). F^o is the drag on the parcels
+pushed through the old fluid; with the drag implicit in both phases, F = D (u_f - u_p(u_f)) and
+u_p = (u_p^o + dt (D u_f + a)) / (1 + D dt), so dF/du_f = D / (1 + D dt) per unit mass (derived here from
+Eq. 43; over sub-steps h the lag 1 - r is the product of their 1/(1 + D h)). For D dt >> 1 the fluid then
+carries the grains' inertia, theta_p rho_p. With beta = sum n rho_p V_p D_p (every parcel held at its pushed
+velocity) a fine suspension anchored the fluid to its old velocity, as if its density were rho_f + beta dt: a
+lock exchange of 20 um grains ran at Fr = 0.03 instead of ~0.4-0.5 (tests/proppant/test_lock_exchange.py;
+docs/stability.md had named this linearisation as a suspect). Parcels that do not follow u_f keep r_p = 0, the
+full drag implicit: those the push stopped (walls, packing cap, bed friction, the threshold of motion,
+bridging: a velocity component exactly 0) and those in a dense bed (theta_p at the parcel >=
+damping_threshold x theta_cp, where collision damping and the packing stress, not drag alone, set their
+velocity); explicit drag there would limit dt to ~2 rho_f theta_f / beta
 (under a millisecond in a packed bed of sand, where it drove spurious circulation).
 """
 
@@ -115,11 +127,23 @@ def pressure_reaction(fields: GridFields) -> tuple[np.ndarray, np.ndarray]:
     return out[0], out[1]
 
 
-def unit_slip(seen: ParcelFluid, parcels: Parcels) -> ParcelFluid:
-    """``seen`` with a fluid velocity 1 m/s faster than each parcel in x and z and no pressure gradient: the
-    exchange (Eq. 39) of it is the drag coefficient beta = sum n rho_p V_p D_p I / V_face on the faces."""
+def unit_slip(seen: ParcelFluid, parcels: Parcels, lag_x: np.ndarray, lag_z: np.ndarray) -> ParcelFluid:
+    """``seen`` with a fluid velocity faster than each parcel by its lag (1 - r_p, parcel_response) in x and z
+    and no pressure gradient: the exchange (Eq. 39) of it is the implicit drag coefficient beta = sum n rho_p
+    V_p D_p (1 - r_p) I / V_face on the faces (module docstring)."""
     zero = np.zeros_like(seen.dpdx)
-    return dataclasses.replace(seen, fluid_u=parcels.u + 1.0, fluid_v=parcels.v + 1.0, dpdx=zero, dpdz=zero)
+    return dataclasses.replace(seen, fluid_u=parcels.u + lag_x, fluid_v=parcels.v + lag_z, dpdx=zero, dpdz=zero)
+
+
+def parcel_response(lag: np.ndarray, velocity: np.ndarray, drag: np.ndarray, h: float,
+                    held: np.ndarray) -> np.ndarray:
+    """1 - r after one more sub-step h of Eq. 43: a parcel following the fluid keeps 1/(1 + D h) of the lag
+    it had (r = (r^o + D h)/(1 + D h); the collision damping relaxes a parcel towards its cell's mean velocity,
+    which follows u_f as the parcel does). Lag 1 (no response) where the push stopped the parcel (velocity
+    exactly 0) or where it is ``held`` in a dense bed, whose packing stress (Eq. 16, the limiter, the packing
+    cap) and collision damping, not drag alone, set its velocity (``held``: theta_p >= damping_threshold x
+    theta_cp)."""
+    return np.where((velocity == 0.0) | held, 1.0, lag / (1.0 + drag * h))
 
 
 @dataclass(frozen=True)
@@ -321,6 +345,7 @@ class ProppantSimulation:
         nz, nx = self.grid.shape
         fx, bx = np.zeros((nz, nx + 1)), np.zeros((nz, nx + 1))
         fz, bz = np.zeros((nz + 1, nx)), np.zeros((nz + 1, nx))
+        lag_x, lag_z = np.ones(self.parcels.n), np.ones(self.parcels.n)
         for s in range(n):
             moments = self.backend.scatter(self.parcels, frame, width)
             fields = grid_fields(frame, width, self.fluid.u, self.fluid.v, self.fluid.p, moments, self.params)
@@ -331,16 +356,23 @@ class ProppantSimulation:
             reaction = pressure_reaction(fields)
             fx += (force[0] + reaction[0]) / n
             fz += (force[1] + reaction[1]) / n
-            beta = self.backend.exchange(self.parcels, unit_slip(seen, self.parcels), drag, frame, width)
+            held = seen.volume_fraction >= self.params.damping_threshold * self.params.theta_cp
+            lag_x = parcel_response(lag_x, self.parcels.u, drag, h, held)
+            lag_z = parcel_response(lag_z, self.parcels.v, drag, h, held)
+            beta = self.backend.exchange(self.parcels, unit_slip(seen, self.parcels, lag_x, lag_z), drag, frame,
+                                         width)
             bx += beta[0] / n
             bz += beta[1] / n
             self._check_parcels(t0 + (s + 1) * h)
-            self._remove_outflow()
+            kept = self._remove_outflow()
+            lag_x, lag_z = lag_x[kept], lag_z[kept]
         return fx, fz, bx, bz
 
-    def _remove_outflow(self) -> None:
+    def _remove_outflow(self) -> np.ndarray:
+        """Drop the parcels in outlet cells (their solid volume counted as outflow); returns the mask of the
+        parcels kept, over the parcels before the call."""
         if not self.outlets.any() or self.parcels.n == 0:
-            return
+            return np.ones(self.parcels.n, dtype=bool)
         frame = self.grid.frame
         i = np.clip(np.floor((self.parcels.x - frame.x0) / frame.dx + 0.5).astype(int), 0, self.grid.nx - 1)
         k = np.clip(np.floor((self.parcels.z - frame.z0) / frame.dz + 0.5).astype(int), 0, self.grid.nz - 1)
@@ -348,6 +380,7 @@ class ProppantSimulation:
         if leaving.any():
             self.outflow += float(np.sum(self.parcels.solid_volume()[leaving]))
             self.parcels.drop(leaving)
+        return ~leaving
 
     def _check_fluid(self, t: float) -> None:
         for name in ("u", "v", "p"):
