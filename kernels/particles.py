@@ -441,14 +441,28 @@ def row(s: ti.template(), j: ti.template()):
 
 
 @ti.func
+def buoyant_gravity(inv_rho, rho_f: ti.f64, gravity: ti.f64):
+    """g' = (1 - rho_f / rho_p) g (elementwise), from 1 / rho_p."""
+    return (1.0 - rho_f * inv_rho) * gravity
+
+
+@ti.func
+def friction_speed(p: ti.i32, density: ti.template(), damping: ti.template(), drag: ti.template(), dt: ti.f64,
+                   rho_f: ti.f64, gravity: ti.f64, bed_friction: ti.f64) -> ti.f64:
+    """The most speed that bed friction can take from parcel p in a step, dt mu_b |g'| / den with den = 1 +
+    dt (D_p + tau_D^-1 / 2) of its last drag solve (velocity_lanes; particle_ops_numpy._bed_friction)."""
+    inv_den = 1.0 / (1.0 + dt * (drag[p] + 0.5 * damping[p]))
+    return dt * bed_friction * ti.abs(buoyant_gravity(1.0 / density[p], rho_f, gravity)) * inv_den
+
+
+@ti.func
 def velocity_lanes(p0: ti.i32, n: ti.i32, u: ti.template(), v: ti.template(), radius: ti.template(),
                    density: ti.template(), s: ti.template(), dt: ti.f64, rho_f: ti.f64, mu: ti.f64,
                    gravity: ti.f64, theta_cp: ti.f64, epsilon: ti.f64, restitution: ti.f64, law: ti.i32,
-                   re_coefficient: ti.f64, iterations: ti.i32, bed_friction: ti.f64):
-    """New velocities (Eq. 43 with the packing limiter of particle_ops_numpy.push), D_p of the last drag solve
-    and the most speed that bed friction can take (dt mu_b |g'| / den, particle_ops_numpy._bed_friction) of the
-    LANES parcels p0, p0 + 1, ... (vectors; lanes past n repeat the last parcel), which see s (SEEN, LANES),
-    rows in the order of ParcelFluid. One power Re^a per drag iteration, a = 0.687 or 2/3 by the law.
+                   re_coefficient: ti.f64, iterations: ti.i32):
+    """New velocities (Eq. 43 with the packing limiter of particle_ops_numpy.push) and D_p of the last drag
+    solve of the LANES parcels p0, p0 + 1, ... (vectors; lanes past n repeat the last parcel), which see s
+    (SEEN, LANES), rows in the order of ParcelFluid. One power Re^a per drag iteration, a = 0.687 or 2/3 by the law.
 
     D_p = 4.5 mu / (rho_p r^2) x C_d Re / 24 (Eq. 13-15, closures.drag_rate): law 0 Eq. 14 (theta_f^-2.65
     (1 + c Re^0.687) below Re = 1000, else 0.44 Re / 24 theta_f^-2.65), law 1 Snider (2001)."""
@@ -465,7 +479,7 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, u: ti.template(), v: ti.template(), ra
     mean_v = row(s, 8)
     half_rate = 0.5 * row(s, 9)
     inv_rho = 1.0 / rho_p
-    buoyant_g = (1.0 - rho_f * inv_rho) * gravity
+    buoyant_g = buoyant_gravity(inv_rho, rho_f, gravity)
     log_tf = lanewise_log(1.0 - ti.min(theta, theta_cp))  # theta_f of closures.fluid_fraction
     hinder = lanewise_exp(-2.65 * log_tf)
     hinder_snider = hinder * 0.0
@@ -497,7 +511,7 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, u: ti.template(), v: ti.template(), ra
     gz = row(s, 5)
     un = un + limited(scale * gx, mean_u - un, gx, restitution)
     vn = vn + limited(scale * gz, mean_v - vn, gz, restitution)
-    return un, vn, drag, dt * bed_friction * ti.abs(buoyant_g) * inv_den
+    return un, vn, drag
 
 
 @ti.func
@@ -531,14 +545,15 @@ def push_lanes(p0: ti.i32, n: ti.i32, s: ti.template(), x: ti.template(), z: ti.
                cell_mask: ti.template(), theta_grid: ti.template(), dt: ti.f64, rho_f: ti.f64, mu: ti.f64,
                gravity: ti.f64, theta_cp: ti.f64, epsilon: ti.f64, restitution: ti.f64, law: ti.i32,
                re_coefficient: ti.f64, bridging_factor: ti.f64, iterations: ti.i32, bed_friction: ti.f64,
-               friction_fraction: ti.f64, shields: ti.i32, wall_law: ti.i32, drag_out: ti.template()):
+               friction_fraction: ti.f64, shields: ti.i32, wall_law: ti.i32, drag_out: ti.template(),
+               s_u: ti.template(), s_damping: ti.template(), s_width: ti.template()):
     """Eq. 43-44 in place for the LANES parcels p0, p0 + 1, ... (< n) that see s: velocity_lanes; then per
     parcel bed friction (on_bed), the threshold of motion on a bed surface (deposited, where ``shields``) and
-    bridging (particle_ops_numpy.push), and move."""
-    un, vn, drag, friction = velocity_lanes(p0, n, u, v, radius, density, s, dt, rho_f, mu, gravity, theta_cp,
-                                            epsilon, restitution, law, re_coefficient, iterations, bed_friction)
-    seen_width = row(s, SEEN - 1)
-    seen_u = row(s, 0)
+    bridging (particle_ops_numpy.push), and move. The per-parcel loop reads what it needs of a parcel from
+    the arrays (s_u, s_width; friction_speed from drag_out), never a lane of a vector at its runtime index l:
+    such an index makes Taichi keep the vectors in stack arrays, which made the whole push 1.3x slower."""
+    un, vn, drag = velocity_lanes(p0, n, u, v, radius, density, s, dt, rho_f, mu, gravity, theta_cp, epsilon,
+                                  restitution, law, re_coefficient, iterations)
     for l in ti.static(range(LANES)):
         if p0 + l < n:
             u[p0 + l] = un[l]
@@ -551,14 +566,15 @@ def push_lanes(p0: ti.i32, n: ti.i32, s: ti.template(), x: ti.template(), z: ti.
         flag = owner_flags(sx, sz, flags)
         if not flag & LOOSE:
             if on_bed(sx, sz, radius[p], dz, theta_grid, width, friction_fraction) > 0.0:
-                speed = ti.max(ti.abs(u[p]) - friction[l], 0.0)
+                friction = friction_speed(p, density, s_damping, drag_out, dt, rho_f, gravity, bed_friction)
+                speed = ti.max(ti.abs(u[p]) - friction, 0.0)
                 u[p] = -speed if u[p] < 0.0 else speed
                 if shields:
-                    if deposited(sx, sz, seen_u[l], seen_width[l], radius[p], density[p], theta_grid,
+                    if deposited(sx, sz, s_u[p], s_width[p], radius[p], density[p], theta_grid,
                                  friction_fraction, rho_f, mu, gravity, wall_law):
                         u[p] = 0.0
         state[p] = ti.cast(0, ti.i32)
-        if seen_width[l] < bridging_factor * 2.0 * radius[p]:
+        if s_width[p] < bridging_factor * 2.0 * radius[p]:
             u[p] = 0.0
             v[p] = 0.0
             state[p] = ti.cast(1, ti.i32)
@@ -586,7 +602,8 @@ def push(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, state: I1,
                                              s_mean_v, s_damping, s_width))], dt=ti.f64)
         push_lanes(p0, n, s, x, z, u, v, radius, density, state, x0, z0, dx, dz, flags, width, cell_mask,
                    theta_grid, dt, rho_f, mu, gravity, theta_cp, epsilon, restitution, law, re_coefficient,
-                   bridging_factor, iterations, bed_friction, friction_fraction, shields, wall_law, drag_out)
+                   bridging_factor, iterations, bed_friction, friction_fraction, shields, wall_law, drag_out,
+                   s_u, s_damping, s_width)
 
 
 @ti.func
