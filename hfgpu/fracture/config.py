@@ -30,6 +30,10 @@ class FractureNumerics:
         cross it (its parent's crossing time, Eq. 34), so leak-off follows the wetted part of the cell.
     max_front_advance: the most the sub-grid front may move in one step, in cells; a longer step is redone
         with half the time step, so results do not depend on how far apart output times are.
+    front_tracking: "cells" (a cell opens whole when its neighbour meets the front criterion, Eq. 33) or
+        "subgrid" (tip cells: the front crosses the cells around the channel by a distance found from the
+        channel's widths through the inverted tip asymptote, their widths are the asymptote's mean over the
+        crossed part and only that part leaks; see simulator.py).
     leakoff_clock: a cell whose leak-off the positivity ramp held below Carter's demand continues from the
         exposure time its leaked volume corresponds to (leakoff.carter_demand), so time spent dry does not
         count as exposure; off: Carter's law from the opening time, whatever the cell leaked.
@@ -49,6 +53,7 @@ class FractureNumerics:
     partial_tip_cells: bool = True
     max_front_advance: float = 1.0
     leakoff_clock: bool = True
+    front_tracking: str = "cells"
 
 
 def parse_fracture_numerics(t: Table, preset: Preset = BALANCED) -> FractureNumerics:
@@ -73,6 +78,7 @@ def parse_fracture_numerics(t: Table, preset: Preset = BALANCED) -> FractureNume
         partial_tip_cells=t.boolean("partial_tip_cells", d.partial_tip_cells),
         max_front_advance=t.number("max_front_advance", d.max_front_advance, minimum=0.1, maximum=10.0),
         leakoff_clock=t.boolean("leakoff_clock", d.leakoff_clock),
+        front_tracking=t.choice("front_tracking", ("cells", "subgrid"), d.front_tracking),
     )
     t.finish()
     return numerics

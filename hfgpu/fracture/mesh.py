@@ -29,7 +29,8 @@ class Grid:
     fields: dict[str, np.ndarray] = field(default_factory=dict)
 
     FILL = {"active": False, "w": 0.0, "opened": np.nan, "filled": np.nan, "reached": np.nan, "leak_rate": 0.0, "p": 0.0,
-            "leaked": 0.0}
+            "leaked": 0.0, "fill": 0.0,
+            "advance": np.nan}
 
     @classmethod
     def around_injection(cls, dx: float, dz: float, x_inj: float, z_inj: float, half: int) -> "Grid":

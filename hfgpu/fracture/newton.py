@@ -6,7 +6,7 @@ unknowns are the N widths of the active cells and the residual is Eq. 29 (volume
     F_P(w) = A (w_P - w_P^o) + A dL_P g(w_P) - dt [L(w) (sigma + C w)]_P - S_P,
 
 with A = dx dz, L(w) the lubrication operator of :mod:`lubrication`, dL the Carter demand of the step and
-g the positivity ramp of :mod:`leakoff`, S the injected volume. Its analytic Jacobian is
+g the positivity ramp of :mod:`leakoff` (times the wetted fraction, see Pinned cells), S the injected volume. Its analytic Jacobian is
 
     J = diag(A (1 + dL g')) - dt L(w) C - dt D(w),   D = d(L(w) p)/dw at fixed p (conductance derivative).
 
@@ -27,6 +27,11 @@ c0 = C_PP, so x is in metres), which is no longer tied to the elastic relation E
 sigma + C w - p >= 0 is the contact traction); a closed cell whose fluid pressure exceeds sigma + C w opens
 again. Newton is rerun until the set settles (at most CONTACT_PASSES passes). Every cell keeps its mass
 balance (a closing cell drains through its faces), so the volume balance stays exact.
+
+Pinned cells. The tip cells of the sub-grid front (simulator.py, tip_cells.py) enter the same way with their
+prescribed width (``pinned``) in place of 0: their unknown is their fluid pressure, their width is fixed for
+the solve and their mass balance decides how much fluid flows in; ``wetted`` scales each cell's leak-off to
+the part of it behind the front.
 """
 
 from __future__ import annotations
@@ -64,6 +69,8 @@ class StepProblem:
     demand: np.ndarray        # Carter leak-off demand per unit area over the step [m]
     w_eps: np.ndarray         # positivity-ramp width per cell [m]
     w_smooth: float = 0.0     # smoothing width of the conductance's positive part [m]
+    pinned: np.ndarray | None = None   # prescribed widths (tip cells of the sub-grid front), NaN: unknown [m]
+    wetted: np.ndarray | None = None   # wetted fraction of each cell's area that leaks (None: all of it)
 
 
 @dataclass(frozen=True)
@@ -90,13 +97,26 @@ class Elasticity:
         return self.matrix @ w if self.matrix is not None else self.op.matvec(self.ix, self.iz, w)
 
 
+def held_width(prob: StepProblem) -> np.ndarray | float:
+    """Width of a cell whose unknown is its pressure: the prescribed width of a pinned cell, 0 (contact)."""
+    return 0.0 if prob.pinned is None else np.nan_to_num(prob.pinned, nan=0.0)
+
+
 def _split(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray | None):
-    """(w, p) of the unknowns x: w = x, p = sigma + C w (Eq. 28) at open cells; w = 0, p = sigma + c0 x at
-    closed cells (contact: x is the fluid pressure's excess over sigma in units of c0, i.e. metres)."""
+    """(w, p) of the unknowns x: w = x, p = sigma + C w (Eq. 28) at open cells; w = held_width, p = sigma +
+    c0 x at held cells (closed by contact, or pinned: x is the fluid pressure's excess over sigma in units of
+    c0, i.e. metres)."""
     if closed is None or not closed.any():
         return x, prob.sigma + elastic.apply(x)
-    w = np.where(closed, 0.0, x)
+    w = np.where(closed, held_width(prob), x)
     return w, np.where(closed, prob.sigma + elastic.self_stiffness * x, prob.sigma + elastic.apply(w))
+
+
+def leak_fraction(prob: StepProblem, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The fraction of a cell's Carter demand it leaks and its derivative: the positivity ramp g(w)
+    (leakoff.available_fraction) times the cell's wetted fraction."""
+    g, dg = available_fraction(w, prob.w_eps)
+    return (g, dg) if prob.wetted is None else (g * prob.wetted, dg * prob.wetted)
 
 
 def residual(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray | None = None):
@@ -105,7 +125,7 @@ def residual(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.n
     w, p = _split(prob, elastic, x, closed)
     t, *dt_dw = conductance(prob.faces, w, prob.w_smooth)
     lap = divergence_matrix(prob.faces, t, w.size)
-    g, dg = available_fraction(w, prob.w_eps)
+    g, dg = leak_fraction(prob, w)
     f = (prob.area * (w - prob.w_old) + prob.area * prob.demand * g - prob.dt * (lap @ p) - prob.source)
     return f, p, lap, dt_dw, dg
 
@@ -127,7 +147,7 @@ def dense_jacobian(prob: StepProblem, elastic: Elasticity, x: np.ndarray,
     """The analytic Jacobian dF/dx of Eq. 29 (with Eq. 28 eliminated) as a dense matrix."""
     closed = np.zeros(x.size, bool) if closed is None else closed
     _, p, lap, dt_dw, dg = residual(prob, elastic, x, closed)
-    w = np.where(closed, 0.0, x)
+    w = np.where(closed, held_width(prob), x)
     return _dense(prob, elastic, lap, _conductance_jacobian(prob, w, p, dt_dw),
                   prob.area * (1.0 + prob.demand * dg), closed)
 
@@ -176,7 +196,7 @@ def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nd
     it = 0
     for it in range(1, max_iterations + 1):
         diag = prob.area * (1.0 + prob.demand * dg)
-        cond = _conductance_jacobian(prob, np.where(closed, 0.0, x), p, dt_dw)
+        cond = _conductance_jacobian(prob, np.where(closed, held_width(prob), x), p, dt_dw)
         try:
             if elastic.matrix is not None:
                 lu = scipy.linalg.lu_factor(_dense(prob, elastic, lap, cond, diag, closed), check_finite=False)
@@ -221,7 +241,10 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
     (cells with w < 0 closed, closed cells whose fluid pressure exceeds sigma + C w opened) and Newton rerun
     until it settles (at most CONTACT_PASSES times); never raises on failure."""
     x = (start_widths(prob) if w_start is None else w_start).astype(float, copy=True)
-    closed = np.zeros(x.size, bool)
+    pinned = np.zeros(x.size, bool) if prob.pinned is None else np.isfinite(prob.pinned)
+    closed = pinned.copy()
+    if pinned.any():   # a pinned cell's unknown starts at the elastic pressure of the start widths
+        x[pinned] = elastic.apply(np.where(pinned, prob.pinned, x))[pinned] / elastic.self_stiffness
     iterations = 0
     for _ in range(CONTACT_PASSES):
         x, converged, it = _newton(prob, elastic, x, closed, tolerance, max_iterations)
@@ -230,14 +253,14 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
             break
         w, p = _split(prob, elastic, x, closed)
         to_close = ~closed & (w < -CONTACT_TOLERANCE * float(np.abs(w).max()))
-        to_open = closed & (prob.sigma + elastic.apply(w) < p)
+        to_open = closed & ~pinned & (prob.sigma + elastic.apply(w) < p)
         if not (to_close.any() or to_open.any()):
             break
         x = np.where(to_close, (p - prob.sigma) / elastic.self_stiffness, np.where(to_open, 0.0, x))
         closed = (closed | to_close) & ~to_open
     f, p, *_ = residual(prob, elastic, x, closed)
-    w = np.where(closed, 0.0, x)
-    g, _ = available_fraction(w, prob.w_eps)
+    w = np.where(closed, held_width(prob), x)
+    g, _ = leak_fraction(prob, w)
     ok = converged and bool(np.all(np.isfinite(f)))
     return StepResult(w=w, p=p, leaked=prob.area * prob.demand * g, iterations=iterations, converged=ok,
                       residual=f)

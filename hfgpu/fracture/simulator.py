@@ -32,6 +32,17 @@ field ``leaked``); a cell the positivity ramp held below its Carter demand (open
 continues from the exposure time that volume corresponds to, not from its opening time
 (leakoff.carter_demand), so the time it spent dry does not count as exposure and the lost demand is
 not lost for good. Coarsening carries it as a volume (sum of the children / 9).
+
+Sub-grid front (``front_tracking = "subgrid"``; tip_cells.py). Instead of opening whole cells, the front
+lies inside tip cells: their widths are pinned to the tip asymptote's mean over the part behind the front
+(their fluid pressure is then the unknown of their mass balance, newton.py), only that part leaks (``fill``,
+the wetted fraction; the leak-off clock runs per wetted area), and the front is placed by the level set
+from the ribbon cells' inverted widths. Each step iterates solve -> front -> solve until the front's
+position at every tip cell reproduces itself (``_front_iterations``); cells the front enters become tip
+cells, cells it has crossed join the channel. This removes the whole-ring openings that, in leak-off
+dominated growth, starve the fracture after each opening (case IV: inlet width -57 % -> -9 %). The time step
+follows the measured front advance (Eq. 35 with V_T = advance / dt). Coarsening makes every coarse cell a
+channel cell; the next step places the front again.
 """
 
 from __future__ import annotations
@@ -51,9 +62,13 @@ from .front import DIRECTIONS, TipModel, cells_to_open, edge_cells, front_distan
 from .leakoff import carter_demand, carter_volume
 from .lubrication import build_faces
 from .mesh import GROW, Grid
-from .newton import Elasticity, StepProblem, solve_step
+from .newton import Elasticity, StepProblem, solve_step, start_widths
+from .tip_cells import fill_and_width, level_set, ribbon_distances
 
 K_PRIME_FACTOR = math.sqrt(32.0 / math.pi)   # K' = sqrt(32/pi) K_Ic
+FRONT_ITERATIONS = 30
+FRONT_TOLERANCE = 1e-2
+FRONT_RELAXATION = 0.5
 
 
 def _check_scene(scene) -> None:
@@ -100,6 +115,30 @@ def start_time(schedule, e_prime: float, mu_prime: float, k_prime: float, c_prim
         return math.inf, power
     t0 = brentq(late, schedule.stages[0].until, schedule.end, xtol=1e-12 * schedule.end)
     return t0, initial_time(e_prime, mu_prime, k_prime, c_prime, schedule.volume(t0) / t0, radius)[1]
+
+
+class _Brackets:
+    """Per-cell brackets [lo, hi] of the root of r(ell) = F(ell) - ell, r decreasing (positive below the
+    root), with r at both ends, for ``_Engine._front_iterations``."""
+
+    def __init__(self, shape: tuple[int, int]):
+        self.lo, self.r_lo, self.hi, self.r_hi = (np.full(shape, np.nan) for _ in range(4))
+        self.side = np.zeros(shape, int)
+
+    def next(self, ell: np.ndarray, target: np.ndarray, cells: np.ndarray) -> np.ndarray:
+        """The next iterate from ell and F(ell) = target: regula falsi inside the bracket where both ends
+        are known (Illinois: an end kept twice in a row has its residual halved), else F(ell)."""
+        r = target - ell
+        up, down = cells & (r > 0.0), cells & (r <= 0.0)
+        self.r_hi[up & (self.side == 1)] *= 0.5
+        self.r_lo[down & (self.side == -1)] *= 0.5
+        self.lo[up], self.r_lo[up] = ell[up], r[up]
+        self.hi[down], self.r_hi[down] = ell[down], r[down]
+        self.side[up], self.side[down] = 1, -1
+        both = np.isfinite(self.lo) & np.isfinite(self.hi)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            falsi = self.lo + self.r_lo * (self.hi - self.lo) / (self.r_lo - self.r_hi)
+        return np.where(both, falsi, target)
 
 
 class _Engine:
@@ -154,6 +193,7 @@ class _Engine:
         self.steps = self.newton_iterations = self.retries = self.rejected = self.coarsenings = 0
         self.v_tip = 0.0
         self.max_balance_error = 0.0
+        g["fill"][act] = 1.0
 
     def _properties(self) -> None:
         """sigma_0, K' = sqrt(32/pi) K_Ic and C' = 2 C_L at every box cell, from the layer table."""
@@ -179,51 +219,173 @@ class _Engine:
     def step(self, dt: float) -> float:
         """Advance by dt; returns the step taken. A step whose Newton iteration fails, or in which the front
         moves more than ``max_front_advance`` cells (``_front_advance``), is redone with half the step."""
+        if self.num.front_tracking == "subgrid":
+            return self._step_subgrid(dt)
         g = self.grid
         sel = (self.rows, self.cols)
         w_old = g["w"][sel]
-        tau = g["opened"][sel]
-        filled = g["filled"][sel] if self.num.partial_tip_cells else None
-        leaked_old = g["leaked"][sel]
         reach_old = self._front_reach(g["w"], g["p"], self.t)
         h = min(self.dx, self.dz)
         for attempt in range(self.num.max_step_retries + 1):
-            source = np.zeros(w_old.size)
-            source[self.inj] = self.schedule.mean_rate(self.t, self.t + dt) * dt
-            if self.num.leakoff_clock:
-                demand = carter_demand(self.cprime_a, tau, leaked_old, self.t, self.t + dt, filled)
-            else:
-                demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt, filled)
-            w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
-            prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
-                               demand, w_eps, 1e-3 * float(w_old.max()))
-            res = solve_step(prob, self.elastic, self.num.newton_tolerance, self.num.newton_max_iterations)
-            self.newton_iterations += res.iterations
+            res = self._solve(dt)
             if res.converged:
                 advance = self._front_advance(reach_old, res.w, res.p, self.t + dt)
                 if advance <= self.num.max_front_advance * h or attempt == self.num.max_step_retries:
                     break
                 self.rejected += 1
             elif attempt == self.num.max_step_retries:
-                worst = int(np.nanargmax(np.where(np.isfinite(res.residual), np.abs(res.residual), np.inf)))
-                raise SimulationError("Newton iteration failed after the allowed step retries",
-                                      time=self.t + dt, cell=(int(self.ix[worst]), int(self.iz[worst])),
-                                      residual=float(np.abs(res.residual[worst]) / self.area))
+                self._newton_failed(res, dt)
             else:
                 self.retries += 1
             dt *= 0.5
+        self._accept(res, dt, advance)
+        self._advance_front()
+        return dt
+
+    def _solve(self, dt: float, pinned: np.ndarray | None = None, w_start: np.ndarray | None = None):
+        """One implicit step [t, t + dt] from the grid's state (newton.solve_step) on the current active set;
+        ``pinned``: prescribed widths (NaN: unknown) of the active cells, whose ``fill`` is their wetted
+        fraction (sub-grid front); ``w_start``: Newton's first iterate (None: newton.start_widths)."""
+        g = self.grid
+        sel = (self.rows, self.cols)
+        w_old, tau, leaked_old = g["w"][sel], g["opened"][sel], g["leaked"][sel]
+        filled = g["filled"][sel] if self.num.partial_tip_cells and pinned is None else None
+        wetted = None if pinned is None else np.where(np.isfinite(pinned), g["fill"][sel], 1.0)
+        source = np.zeros(w_old.size)
+        source[self.inj] = self.schedule.mean_rate(self.t, self.t + dt) * dt
+        if self.num.leakoff_clock:   # with a wetted fraction: the volume leaked per wetted area
+            clock = leaked_old if wetted is None else np.divide(leaked_old, wetted, out=np.zeros_like(leaked_old),
+                                                                where=wetted > 0.0)
+            demand = carter_demand(self.cprime_a, tau, clock, self.t, self.t + dt, filled)
+        else:
+            demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt, filled)
+        w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
+        prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
+                           demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted)
+        res = solve_step(prob, self.elastic, self.num.newton_tolerance, self.num.newton_max_iterations,
+                         None if w_start is None else np.where(w_start > 0.0, w_start, start_widths(prob)))
+        self.newton_iterations += res.iterations
+        return res
+
+    def _newton_failed(self, res, dt: float) -> None:
+        worst = int(np.nanargmax(np.where(np.isfinite(res.residual), np.abs(res.residual), np.inf)))
+        raise SimulationError("Newton iteration failed after the allowed step retries",
+                              time=self.t + dt, cell=(int(self.ix[worst]), int(self.iz[worst])),
+                              residual=float(np.abs(res.residual[worst]) / self.area))
+
+    def _accept(self, res, dt: float, advance: float) -> None:
+        """Store an accepted step's widths, pressures and leak-off and move the clock."""
         if not (np.all(np.isfinite(res.w)) and np.all(np.isfinite(res.p))):
             raise SimulationError("non-finite width or pressure", time=self.t + dt)
+        g, sel = self.grid, (self.rows, self.cols)
         self.t += dt
         g["w"][sel] = res.w
         g["p"][sel] = res.p
         g["leak_rate"][sel] = res.leaked / (self.area * dt)
-        g["leaked"][sel] = leaked_old + res.leaked / self.area
+        g["leaked"][sel] = g["leaked"][sel] + res.leaked / self.area
         self.leaked_total += float(res.leaked.sum())
         self.v_tip = advance / dt
         self.steps += 1
-        self._advance_front()
+
+    # -- sub-grid front (front_tracking = "subgrid") ------------------------------------------------
+    def _step_subgrid(self, dt: float) -> float:
+        """One step with tip cells (module docstring): the front's position at the tip cells and the step's
+        solution are iterated to a fixed point (``_front_iterations``). A step whose Newton iteration fails,
+        or in which the front moves more than ``max_front_advance`` cells, is redone with half the step."""
+        h = min(self.dx, self.dz)
+        before = self.grid.shape
+        self.grid.ensure_margin(4)   # room for the front to move within the step without growing the box
+        if self.grid.shape != before:
+            self._use_grid(self.grid)
+        start = self._copy(self.grid)
+        for attempt in range(self.num.max_step_retries + 1):
+            res, advance, ok = self._front_iterations(dt, start)
+            if ok and (advance <= self.num.max_front_advance * h or attempt == self.num.max_step_retries):
+                break
+            if not ok and attempt == self.num.max_step_retries:
+                self._newton_failed(res, dt)
+            self.retries += not ok
+            self.rejected += ok
+            self._use_grid(self._copy(start))
+            dt *= 0.5
+        self._accept(res, dt, advance)
+        self.v_front, self.t_front = self.v_tip, self.t
+        self._coarsen_if_wide()
         return dt
+
+    def _front_iterations(self, dt: float, start) -> tuple:
+        """(result, front advance [m], converged) of a step from the grid ``start``: solve with the tip
+        widths pinned, place the front (tip_cells: ribbon distances, level set; never backwards), until the
+        front's position at every tip cell reproduces itself, |F(a) - a| < FRONT_TOLERANCE cells (a = how far
+        the front is past the cell's centre). F decreases with a (a wider tip leaves less fluid to the
+        ribbon), so each cell's root is bracketed as the iterations go and found by regula falsi (Illinois)
+        inside its bracket, plain iteration a = F(a) until it has one. A cell the front enters becomes a tip
+        cell (active, its Carter opening time the step's middle); one it has crossed joins the channel (its
+        width unknown); either restarts the brackets."""
+        g = self.grid
+        h = min(self.dx, self.dz)
+        was_tip = start["active"] & (start["fill"] < 1.0)
+        floor = np.where(was_tip, start["advance"], -np.inf)
+        start_w = np.where(start["active"], start["w"], 0.0)   # a tip cell does not give back fluid
+        pinned_box = np.where(g["active"] & (g["fill"] < 1.0), g["w"], np.nan)
+        advance = 0.0
+        last = None   # the previous iteration's widths on the box: Newton's first iterate
+        bracket = _Brackets(g.shape)
+        for _ in range(FRONT_ITERATIONS):
+            res = self._solve(dt, pinned_box[self.rows, self.cols], None if last is None else last[self.rows, self.cols])
+            if not res.converged:
+                return res, advance, False
+            w_box, p_box = g["w"].copy(), g["p"].copy()
+            w_box[self.rows, self.cols], p_box[self.rows, self.cols] = res.w, res.p
+            last = np.where(g["active"], w_box, 0.0)
+            channel = g["active"] & (g["fill"] >= 1.0)
+            s_rib, v_rib = ribbon_distances(self.tip, channel, w_box, p_box, self.kprime_box, self.cprime_box,
+                                            g["reached"], self.t + dt, self.dx, self.dz)
+            target, nx, nz, src = level_set(s_rib, channel, self.dx, self.dz)
+            cand = np.isfinite(target)
+            target = np.where(cand, np.fmax(target, floor), np.nan)
+            reach = -0.5 * (np.abs(nx) * self.dx + np.abs(nz) * self.dz)   # the front at the cell's nearest corner
+            known = g["active"] & np.isfinite(g["advance"])
+            now = np.where(known, g["advance"], reach)
+            live = cand & (known | (target > reach))
+            if float(np.max(np.abs(target - now)[live], initial=0.0)) < FRONT_TOLERANCE * h:
+                return res, advance, True
+            moved = np.where(cand, bracket.next(np.where(cand, now, 0.0), np.where(cand, target, 0.0), cand), np.nan)
+            ks = src[cand]
+            fill, width = fill_and_width(self.tip, moved[cand], nx[cand], nz[cand], self.kprime_box.ravel()[ks],
+                                         self.cprime_box.ravel()[ks], v_rib.ravel()[ks], self.dx, self.dz)
+            fill_box, width_box = np.zeros(g.shape), np.zeros(g.shape)
+            fill_box[cand], width_box[cand] = fill, width
+            tip = cand & (fill_box > 0.0)
+            crossed = tip & (fill_box >= 1.0)
+            entered = tip & ~g["active"]
+            advance = max(advance, float(np.max((moved - np.where(was_tip, floor, -0.5 * h))[tip], initial=0.0)))
+            if entered.any():
+                g.fields["active"] = g["active"] | entered
+                for name in ("opened", "reached", "filled"):
+                    g[name][entered] = self.t + 0.5 * dt
+                g["w"][entered] = 0.0
+            g["advance"][tip] = moved[tip]
+            g["fill"][tip] = fill_box[tip]
+            keep = tip & ~crossed
+            pinned_box = np.where(g["active"] & (g["fill"] < 1.0), pinned_box, np.nan)
+            pinned_box[keep] = np.maximum(width_box[keep], start_w[keep])
+            pinned_box[entered & ~crossed] = np.maximum(width_box[entered & ~crossed], 0.0)
+            if entered.any() or crossed.any():
+                self._rebuild()
+                bracket = _Brackets(g.shape)
+        res = self._solve(dt, pinned_box[self.rows, self.cols])   # the last front, on the last active set
+        return res, advance, res.converged
+
+    @staticmethod
+    def _copy(grid) -> Grid:
+        return Grid(grid.dx, grid.dz, grid.x_inj, grid.z_inj, grid.ix0, grid.iz0,
+                    {name: array.copy() for name, array in grid.fields.items()})
+
+    def _use_grid(self, grid) -> None:
+        self.grid = grid
+        self._properties()
+        self._rebuild()
 
     def _front_reach(self, w: np.ndarray, p: np.ndarray, t: float) -> np.ndarray:
         """Largest sub-grid front distance s (Eq. 33 inverted, front.front_distances) of every box cell,
@@ -283,6 +445,7 @@ class _Engine:
         new["opened"][at] = c.earliest(g["opened"][sel])
         new["reached"][at] = c.earliest(g["reached"][sel])
         new["filled"][at] = -c.earliest(-g["filled"][sel])
+        new["fill"][at] = 1.0
         self.grid = new
         self.dx, self.dz = new.dx, new.dz
         self.area = self.dx * self.dz
@@ -299,7 +462,7 @@ class _Engine:
         v = self.v_front
         if self.t > self.t_front:
             v = min(v, h / (self.t - self.t_front))
-        v = max(v, self.v_tip)
+        v = max(v, self.v_tip, 1e-300)
         return min(self.num.time_step_relaxation * h / v, self.num.max_step_growth * dt_prev)
 
     # ------------------------------------------------------------------------------------------
@@ -322,23 +485,35 @@ class _Engine:
             extras={f"front_{k}": np.array(v) for k, v in self.front().items()})
 
     def front(self) -> dict:
-        """Sub-grid front: distances r + s from the injection point at the edge cells (s from the inverted
-        tip asymptote, capped at one cell) and the extents up (-z), down (+z), left (-x), right (+x)."""
+        """Sub-grid front: distances from the injection point to the front and its extents up (-z), down
+        (+z), left (-x), right (+x). With cells: r + s at the edge cells (s from the inverted tip asymptote,
+        capped at one cell); with the sub-grid front: the points x + a n of the tip cells (tip_cells)."""
         g = self.grid
         xo, zo = g.offsets()
-        dist = front_distances(self.tip, g["active"], g["w"], g["p"], self.kprime_box, self.cprime_box,
-                               g["reached"], self.t, self.dx, self.dz)
-        best = np.zeros(xo.shape)
-        ext = {}
-        for name, (dk, di), s in zip(("right", "left", "down", "up"), DIRECTIONS, dist):
-            s = np.minimum(s, self.dz if dk else self.dx)
-            coord = (zo * dk if dk else xo * di) + s
-            ext[name] = max(float(np.nanmax(coord)) if np.isfinite(coord).any() else 0.0, 0.0)
-            best = np.fmax(best, s)
-        edge = edge_cells(g["active"])
-        radii = np.hypot(xo, zo)[edge] + best[edge]
+        if self.num.front_tracking == "subgrid":
+            channel = g["active"] & (g["fill"] >= 1.0)
+            s_rib, _ = ribbon_distances(self.tip, channel, g["w"], g["p"], self.kprime_box, self.cprime_box,
+                                        g["reached"], self.t, self.dx, self.dz)
+            _, nx, nz, _ = level_set(s_rib, channel, self.dx, self.dz)
+            tips = g["active"] & ~channel & np.isfinite(g["advance"]) & np.isfinite(nx)
+            px, pz = (xo + g["advance"] * nx)[tips], (zo + g["advance"] * nz)[tips]
+            radii = np.hypot(px, pz)
+            ext = dict(right=px.max(), left=-px.min(), down=pz.max(), up=-pz.min())
+        else:
+            dist = front_distances(self.tip, g["active"], g["w"], g["p"], self.kprime_box, self.cprime_box,
+                                   g["reached"], self.t, self.dx, self.dz)
+            best = np.zeros(xo.shape)
+            ext = {}
+            for name, (dk, di), s in zip(("right", "left", "down", "up"), DIRECTIONS, dist):
+                s = np.minimum(s, self.dz if dk else self.dx)
+                coord = (zo * dk if dk else xo * di) + s
+                ext[name] = np.nanmax(coord) if np.isfinite(coord).any() else 0.0
+                best = np.fmax(best, s)
+            edge = edge_cells(g["active"])
+            radii = np.hypot(xo, zo)[edge] + best[edge]
         return dict(radius=float(radii.mean()), radius_min=float(radii.min()), radius_max=float(radii.max()),
-                    area_radius=math.sqrt(g["active"].sum() * self.area / math.pi), **ext)
+                    area_radius=math.sqrt(g["active"].sum() * self.area / math.pi),
+                    **{k: max(float(v), 0.0) for k, v in ext.items()})
 
     # -- checkpoints ------------------------------------------------------------------------------
     #: Attributes (numbers or arrays) a checkpoint carries besides the grid: list every new persistent one here.

@@ -104,6 +104,8 @@ def test_bad_input_is_rejected_before_work_starts():
         load_scene(scene_text(fracture='[fracture]\ntip_velocity = "sonic"'))
     with pytest.raises(SceneError, match="fracture.partial_tip_cells"):
         load_scene(scene_text(fracture='[fracture]\npartial_tip_cells = 3'))
+    with pytest.raises(SceneError, match="fracture.front_tracking.*subgrid"):
+        load_scene(scene_text(fracture='[fracture]\nfront_tracking = "level set"'))
     with pytest.raises(SceneError, match="fracture.initial_radius_cells"):
         simulate(scene(end_time="0.001 s", cell="1 m"), MemorySink())
 
