@@ -40,15 +40,20 @@ def test_measured_extents_match_the_reference_table(shared_dir):
 
 @pytest.mark.slow
 def test_wu2008_front_extents(shared_dir):
-    """Goal: up, down and lateral fronts within 10 % at every time. Measured (6 mm cells): up -1.2 / +8.3 /
-    +10.1 / +6.2 / +4.7 %, down -19.6 / -8.8 / -5.0 / +3.9 / +3.1 % at 22 / 60 / 144 / 376 / 665 s. At 22 s the
-    fracture is ~5 cells across, so it is held to 25 % only; up at 144 s is 0.1 % past the goal."""
+    """Goal: up, down and lateral fronts within 10 % at every time. Measured (2 mm cells coarsened to 6 mm at
+    45 cells across): up +10.4 / +6.8 / +9.1 / +6.1 / +4.5 %, down -10.2 / -7.6 / -5.0 / +3.9 / +3.1 %, lateral
+    -5.5 / -3.2 / -0.9 / +6.4 / +3.3 % at 22 / 60 / 144 / 376 / 665 s (6 mm throughout: down -19.6 % and up
+    +10.1 % at 22 and 144 s). At 22 s the fracture is still inside the uniform 50 mm middle layer, where any
+    planar model's footprint is a circle about the injection point; the measured one (up 15.0, down 18.4 mm) is
+    that circle shifted 1.7 mm down, so up and down are held to 12 % there and their sum, the height (-0.9 %),
+    to the 10 %."""
     measured = measured_extents(shared_dir)
     simulated = simulated_extents()
     for t in TIMES:
         up, down, left, right = simulated[t]
         m_up, m_down, m_left, m_right = measured[t]
-        tol = 0.25 if t < 60.0 else 0.1
-        assert down == pytest.approx(m_down, rel=tol), (t, simulated[t], measured[t])
-        assert 0.5 * (left + right) == pytest.approx(0.5 * (m_left + m_right), rel=tol), (t, simulated[t])
-        assert up == pytest.approx(m_up, rel=max(tol, 0.12)), (t, simulated[t], measured[t])
+        each = 0.12 if t < 60.0 else 0.1
+        assert down == pytest.approx(m_down, rel=each), (t, simulated[t], measured[t])
+        assert up == pytest.approx(m_up, rel=each), (t, simulated[t], measured[t])
+        assert up + down == pytest.approx(m_up + m_down, rel=0.1), (t, simulated[t], measured[t])
+        assert 0.5 * (left + right) == pytest.approx(0.5 * (m_left + m_right), rel=0.1), (t, simulated[t])
