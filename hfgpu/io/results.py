@@ -11,9 +11,9 @@ Layout (docs/results-format.md is the full contract; extend, never rename)::
     /summary                attrs status, message, and the simulator's scalar summary values
     /checkpoint             attrs time and record counts; state/...: the simulator's state (removed when complete)
 
-Integrity: the file is open only while a snapshot is written. A snapshot is built under a temporary
-name (``_incomplete``) and moved to its final zero-padded name once complete, then the file is flushed
-and closed; balance records are buffered and written with each snapshot (and at close). A run killed at
+Integrity: the file is open only while a snapshot is written, and every change is made on a copy that is
+renamed over the file when complete (``_edit``: HDF5 is not crash-safe on its own). A snapshot is built under
+a temporary name (``_incomplete``) and moved to its final zero-padded name once complete; balance records are buffered and written with each snapshot (and at close). A run killed at
 any moment therefore leaves every completed snapshot readable; a leftover ``_incomplete`` group is
 ignored by the reader. ``status`` is "running" until :meth:`ResultsWriter.close` writes "complete" or
 "failed: <message>"; a file still saying "running" after its run ended was interrupted.
@@ -27,8 +27,11 @@ reuses the old one's space instead of growing the file.
 
 from __future__ import annotations
 
+import contextlib
 import functools
-from collections.abc import Sequence
+import os
+import shutil
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
@@ -67,6 +70,26 @@ _BALANCE_FLUSH_ROWS = 4096
 _COMPRESS_ABOVE = 4096  # elements; smaller arrays are stored plainly
 
 
+@contextlib.contextmanager
+def _edit(path: Path, create: bool = False) -> Iterator[h5py.File]:
+    """The results file open for writing, copy-on-write: the change is made on a copy (``<name>.writing``),
+    which is flushed to disk and then renamed over the file (atomic on POSIX). HDF5 itself is not crash-safe
+    (a kill while the library flushes its metadata can leave an unreadable file: measured once in 40 random
+    SIGKILLs), so the file at ``path`` is at every moment either the previous complete version or the new one."""
+    work = path.with_name(path.name + ".writing")
+    if not create:
+        shutil.copyfile(path, work)
+    try:
+        with _open(work, "w" if create else "a") as f:
+            yield f
+        with open(work, "rb+") as raw:
+            os.fsync(raw.fileno())
+    except BaseException:
+        work.unlink(missing_ok=True)
+        raise
+    os.replace(work, path)
+
+
 def _open(path: Path, mode: str) -> h5py.File:
     """h5py file without HDF5 file locking, so a reader can look at a file while a run writes it; a new file
     tracks its free space persistently (a replaced checkpoint's space is reused in later openings)."""
@@ -88,7 +111,7 @@ class ResultsWriter:
 
         self._start(Path(path), {"fracture": 0, "proppant": 0}, 0.0)
         try:
-            with _open(self.path, "w") as f:
+            with _edit(self.path, create=True) as f:
                 f.attrs.update(format=FORMAT, format_version=FORMAT_VERSION, hfgpu_version=__version__,
                                status="running")
                 _dataset(f, "scene", np.array(getattr(scene, "source", "") or "", dtype=h5py.string_dtype()))
@@ -109,11 +132,11 @@ class ResultsWriter:
         to "running"; ``state`` is the tree the simulator saved at simulated time ``time`` [s]. Raises
         :class:`HfgpuError` for a file that is not a results file or holds no checkpoint."""
         path = Path(path)
-        try:
-            f = _open(path, "a")
-        except OSError as exc:
-            raise HfgpuError(f"cannot open the results file '{path}' to resume: {exc}") from None
-        with f:
+        with contextlib.ExitStack() as stack:
+            try:
+                f = stack.enter_context(_edit(path))
+            except OSError as exc:
+                raise HfgpuError(f"cannot open the results file '{path}' to resume: {exc}") from None
             if f.attrs.get("format") != FORMAT:
                 raise HfgpuError(f"'{path}' is not an hfgpu results file (no format=\"{FORMAT}\" attribute)")
             group = _checkpoint(f, finish_swap=True)
@@ -171,7 +194,7 @@ class ResultsWriter:
         """Replace ``/checkpoint`` with the simulator's ``state`` at simulated time ``time`` [s], after writing the
         buffered balance rows; records the snapshot and balance-row counts it belongs to (see the module
         docstring for the atomic swap)."""
-        with _open(self.path, "a") as f:
+        with _edit(self.path) as f:
             self._write_balance(f)
             f.pop(NEW_CHECKPOINT, None)
             group = f.create_group(NEW_CHECKPOINT)
@@ -195,7 +218,7 @@ class ResultsWriter:
         if self._closed:
             return
         self._closed = True
-        with _open(self.path, "a") as f:
+        with _edit(self.path) as f:
             self._write_balance(f)
             for physics in self._counts:
                 f.pop(f"{physics}/snapshots/{INCOMPLETE}", None)
@@ -228,7 +251,7 @@ class ResultsWriter:
     def _snapshot(self, physics: str, time: float, frame: GridFrame,
                   data: dict[str, tuple[np.ndarray, str]], attrs: dict[str, Any]) -> None:
         self._last_time = max(self._last_time, float(time))
-        with _open(self.path, "a") as f:
+        with _edit(self.path) as f:
             self._write_balance(f)
             parent = f.require_group(f"{physics}/snapshots")
             parent.pop(INCOMPLETE, None)
@@ -246,7 +269,7 @@ class ResultsWriter:
         pending = self._pending[physics]
         pending.append(row)
         if len(pending) >= _BALANCE_FLUSH_ROWS:
-            with _open(self.path, "a") as f:
+            with _edit(self.path) as f:
                 self._write_balance(f)
 
     def _write_balance(self, f: h5py.File) -> None:
