@@ -487,15 +487,18 @@ class _Engine:
     def front(self) -> dict:
         """Sub-grid front: distances from the injection point to the front and its extents up (-z), down
         (+z), left (-x), right (+x). With cells: r + s at the edge cells (s from the inverted tip asymptote,
-        capped at one cell); with the sub-grid front: the points x + a n of the tip cells (tip_cells)."""
+        capped at one cell); with the sub-grid front: the points x + a n of the tip cells (tip_cells), or as
+        with cells where there are none (right after a coarsening)."""
         g = self.grid
         xo, zo = g.offsets()
+        tips = np.zeros(g.shape, bool)
         if self.num.front_tracking == "subgrid":
             channel = g["active"] & (g["fill"] >= 1.0)
             s_rib, _ = ribbon_distances(self.tip, channel, g["w"], g["p"], self.kprime_box, self.cprime_box,
                                         g["reached"], self.t, self.dx, self.dz)
             _, nx, nz, _ = level_set(s_rib, channel, self.dx, self.dz)
             tips = g["active"] & ~channel & np.isfinite(g["advance"]) & np.isfinite(nx)
+        if tips.any():   # none right after a coarsening: every cell is then a channel cell
             px, pz = (xo + g["advance"] * nx)[tips], (zo + g["advance"] * nz)[tips]
             radii = np.hypot(px, pz)
             ext = dict(right=px.max(), left=-px.min(), down=pz.max(), up=-pz.min())
