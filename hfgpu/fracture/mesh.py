@@ -41,6 +41,11 @@ class Grid:
             grid.fields[name] = np.full((n, n), fill)
         return grid
 
+    def copy(self) -> "Grid":
+        """An independent copy (every field array copied)."""
+        return Grid(self.dx, self.dz, self.x_inj, self.z_inj, self.ix0, self.iz0,
+                    {name: array.copy() for name, array in self.fields.items()})
+
     @property
     def shape(self) -> tuple[int, int]:
         return self.fields["active"].shape

@@ -68,7 +68,6 @@ from .tip_cells import fill_and_width, level_set, ribbon_distances
 K_PRIME_FACTOR = math.sqrt(32.0 / math.pi)   # K' = sqrt(32/pi) K_Ic
 FRONT_ITERATIONS = 30
 FRONT_TOLERANCE = 1e-2
-FRONT_RELAXATION = 0.5
 
 
 def _check_scene(scene) -> None:
@@ -297,7 +296,7 @@ class _Engine:
         self.grid.ensure_margin(4)   # room for the front to move within the step without growing the box
         if self.grid.shape != before:
             self._use_grid(self.grid)
-        start = self._copy(self.grid)
+        start = self.grid.copy()
         for attempt in range(self.num.max_step_retries + 1):
             res, advance, ok = self._front_iterations(dt, start)
             if ok and (advance <= self.num.max_front_advance * h or attempt == self.num.max_step_retries):
@@ -306,7 +305,7 @@ class _Engine:
                 self._newton_failed(res, dt)
             self.retries += not ok
             self.rejected += ok
-            self._use_grid(self._copy(start))
+            self._use_grid(start.copy())
             dt *= 0.5
         self._accept(res, dt, advance)
         self.v_front, self.t_front = self.v_tip, self.t
@@ -369,18 +368,12 @@ class _Engine:
             g["fill"][tip] = fill_box[tip]
             keep = tip & ~crossed
             pinned_box = np.where(g["active"] & (g["fill"] < 1.0), pinned_box, np.nan)
-            pinned_box[keep] = np.maximum(width_box[keep], start_w[keep])
-            pinned_box[entered & ~crossed] = np.maximum(width_box[entered & ~crossed], 0.0)
+            pinned_box[keep] = np.maximum(width_box[keep], start_w[keep])   # entered cells: start_w = 0
             if entered.any() or crossed.any():
                 self._rebuild()
                 bracket = _Brackets(g.shape)
         res = self._solve(dt, pinned_box[self.rows, self.cols])   # the last front, on the last active set
         return res, advance, res.converged
-
-    @staticmethod
-    def _copy(grid) -> Grid:
-        return Grid(grid.dx, grid.dz, grid.x_inj, grid.z_inj, grid.ix0, grid.iz0,
-                    {name: array.copy() for name, array in grid.fields.items()})
 
     def _use_grid(self, grid) -> None:
         self.grid = grid

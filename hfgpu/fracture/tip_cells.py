@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .front import DIRECTIONS, OLSON, TipModel, _shift, _tip_cells, invert_tip, tip_width
+from .front import OLSON, TipModel, _per_direction, _shift, _tip_cells, invert_tip, tip_width
 
 QUADRATURE = 8
 _OFFSETS = (np.arange(QUADRATURE) + 0.5) / QUADRATURE - 0.5
@@ -33,7 +33,7 @@ def ribbon_distances(model: TipModel, channel: np.ndarray, w: np.ndarray, p: np.
     non-channel cells); NaN elsewhere."""
     masks, _, vel = _tip_cells(model, channel, w, p, reached, t, dx, dz, box_edge=False)
     v = np.full(w.shape, np.nan)
-    for mask, v_dir in zip(masks, np.split(vel, np.cumsum([int(m.sum()) for m in masks])[:-1])):
+    for mask, v_dir in zip(masks, _per_direction(vel, masks)):
         v[mask] = np.fmax(v[mask], v_dir)
     ribbon = np.isfinite(v)
     s = np.full(w.shape, np.nan)
