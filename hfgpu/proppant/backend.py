@@ -176,7 +176,7 @@ class TaichiBackend:
                 f.fluid_u, f.fluid_v, f.dpdx, f.dpdz, f.dtaudx, f.dtaudz, f.volume_fraction, f.mean_u, f.mean_v,
                 f.damping_rate, f.width)]
             self._k.gather(parcels.x, parcels.z, frame.x0, frame.z0, frame.dx, frame.dz, self._flags(f.width),
-                           f.cell_mask, f.xface_mask, f.zface_mask, *flat, seen)
+                           f.cell_mask, f.xface_mask, f.zface_mask, *flat, *seen)
         return ParcelFluid(*seen)
 
     def push(self, parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFields, dt: float,
