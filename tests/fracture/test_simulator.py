@@ -120,6 +120,17 @@ def test_newton_failure_raises_simulation_error_with_time_cell_and_residual():
     assert "Newton" in str(err)
 
 
+def test_a_step_that_cannot_shrink_enough_stops_the_run_with_a_message():
+    """A sub-grid front that moves more than max_front_advance cells however short the step (here a limit
+    far below what the scene validates, set on the frozen config directly) halves its steps until they fall
+    below MIN_STEP_FRACTION of the time: a SimulationError naming the knob, not a division by zero."""
+    base = scene(**FAST, fracture='[fracture]\nfront_tracking = "subgrid"')
+    sc = base.replace(fracture=dataclasses.replace(base.fracture, max_front_advance=1e-9))
+    with pytest.raises(SimulationError, match="max_front_advance") as info:
+        simulate(sc, MemorySink())
+    assert info.value.time is not None
+
+
 def test_direct_and_krylov_runs_agree():
     base = scene(end_time="30 s", cell="1 m")
     krylov = base.replace(fracture=dataclasses.replace(base.fracture, linear_solver="krylov"))
