@@ -38,6 +38,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import partial
+from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg
@@ -119,15 +120,27 @@ def leak_fraction(prob: StepProblem, w: np.ndarray) -> tuple[np.ndarray, np.ndar
     return (g, dg) if prob.wetted is None else (g * prob.wetted, dg * prob.wetted)
 
 
-def residual(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray | None = None):
-    """Eq. 29 residual F(x) with the widths and pressures of ``_split``, plus p, the conductances and the
+class Residual(NamedTuple):
+    """Eq. 29 at one iterate and what its Jacobian reuses."""
+
+    f: np.ndarray        # the residual, volume per cell over the step [m^3]
+    w: np.ndarray        # widths (``_split``: held cells at held_width)
+    p: np.ndarray        # fluid pressures
+    lap: scipy.sparse.csr_matrix   # the lubrication operator L(w)
+    dt_dw: list          # the face conductances' derivatives
+    g: np.ndarray        # the leaked fraction of the Carter demand (leak_fraction)
+    dg: np.ndarray       # and its derivative
+
+
+def residual(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray | None = None) -> Residual:
+    """Eq. 29 residual F(x) with the widths and pressures of ``_split``, plus the conductances and the
     ramp."""
     w, p = _split(prob, elastic, x, closed)
     t, *dt_dw = conductance(prob.faces, w, prob.w_smooth)
     lap = divergence_matrix(prob.faces, t, w.size)
     g, dg = leak_fraction(prob, w)
     f = (prob.area * (w - prob.w_old) + prob.area * prob.demand * g - prob.dt * (lap @ p) - prob.source)
-    return f, p, lap, dt_dw, dg
+    return Residual(f, w, p, lap, dt_dw, g, dg)
 
 
 def _conductance_jacobian(prob: StepProblem, w: np.ndarray, p: np.ndarray,
@@ -146,10 +159,9 @@ def dense_jacobian(prob: StepProblem, elastic: Elasticity, x: np.ndarray,
                    closed: np.ndarray | None = None) -> np.ndarray:
     """The analytic Jacobian dF/dx of Eq. 29 (with Eq. 28 eliminated) as a dense matrix."""
     closed = np.zeros(x.size, bool) if closed is None else closed
-    _, p, lap, dt_dw, dg = residual(prob, elastic, x, closed)
-    w = np.where(closed, held_width(prob), x)
-    return _dense(prob, elastic, lap, _conductance_jacobian(prob, w, p, dt_dw),
-                  prob.area * (1.0 + prob.demand * dg), closed)
+    r = residual(prob, elastic, x, closed)
+    return _dense(prob, elastic, r.lap, _conductance_jacobian(prob, r.w, r.p, r.dt_dw),
+                  prob.area * (1.0 + prob.demand * r.dg), closed)
 
 
 def _dense(prob, elastic, lap, cond, diag, closed) -> np.ndarray:
@@ -192,33 +204,33 @@ def _krylov_update(prob, elastic, f, lap, cond, diag, rtol, closed):
 def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray, tolerance: float,
             max_iterations: int) -> tuple[np.ndarray, bool, int]:
     """Damped Newton on Eq. 29 for a fixed contact set (module docstring); (x, converged, iterations)."""
-    f, p, lap, dt_dw, dg = residual(prob, elastic, x, closed)
+    r = residual(prob, elastic, x, closed)
     it = 0
     for it in range(1, max_iterations + 1):
-        diag = prob.area * (1.0 + prob.demand * dg)
-        cond = _conductance_jacobian(prob, np.where(closed, held_width(prob), x), p, dt_dw)
+        diag = prob.area * (1.0 + prob.demand * r.dg)
+        cond = _conductance_jacobian(prob, r.w, r.p, r.dt_dw)
         try:
             if elastic.matrix is not None:
-                lu = scipy.linalg.lu_factor(_dense(prob, elastic, lap, cond, diag, closed), check_finite=False)
-                dx = scipy.linalg.lu_solve(lu, -f)
+                lu = scipy.linalg.lu_factor(_dense(prob, elastic, r.lap, cond, diag, closed), check_finite=False)
+                dx = scipy.linalg.lu_solve(lu, -r.f)
                 inverse = partial(scipy.linalg.lu_solve, lu)
             else:
-                dx, inverse = _krylov_update(prob, elastic, f, lap, cond, diag,
+                dx, inverse = _krylov_update(prob, elastic, r.f, r.lap, cond, diag,
                                              min(1e-3, tolerance * 1e-1), closed)
         except (np.linalg.LinAlgError, ValueError):
             return x, False, it
         if not np.all(np.isfinite(dx)):
             return x, False, it
-        scale = np.linalg.norm(inverse(-f)) if elastic.matrix is None else np.linalg.norm(dx)
+        scale = np.linalg.norm(inverse(-r.f)) if elastic.matrix is None else np.linalg.norm(dx)
         step = 1.0
         for _ in range(MONOTONICITY_HALVINGS):
             trial = residual(prob, elastic, x + step * dx, closed)
-            if np.all(np.isfinite(trial[0])) and \
-                    np.linalg.norm(inverse(-trial[0])) <= (1.0 - 0.25 * step) * scale:
+            if np.all(np.isfinite(trial.f)) and \
+                    np.linalg.norm(inverse(-trial.f)) <= (1.0 - 0.25 * step) * scale:
                 break
             step *= 0.5
         x = x + step * dx
-        f, p, lap, dt_dw, dg = trial
+        r = trial
         if np.linalg.norm(dx) < tolerance * max(np.linalg.norm(x), 1e-300):   # undamped update
             return x, True, it
     return x, False, it
@@ -258,9 +270,7 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
             break
         x = np.where(to_close, (p - prob.sigma) / elastic.self_stiffness, np.where(to_open, 0.0, x))
         closed = (closed | to_close) & ~to_open
-    f, p, *_ = residual(prob, elastic, x, closed)
-    w = np.where(closed, held_width(prob), x)
-    g, _ = leak_fraction(prob, w)
-    ok = converged and bool(np.all(np.isfinite(f)))
-    return StepResult(w=w, p=p, leaked=prob.area * prob.demand * g, iterations=iterations, converged=ok,
-                      residual=f)
+    r = residual(prob, elastic, x, closed)
+    ok = converged and bool(np.all(np.isfinite(r.f)))
+    return StepResult(w=r.w, p=r.p, leaked=prob.area * prob.demand * r.g, iterations=iterations, converged=ok,
+                      residual=r.f)
