@@ -37,12 +37,14 @@ Sub-grid front (``front_tracking = "subgrid"``; tip_cells.py). Instead of openin
 lies inside tip cells: their widths are pinned to the tip asymptote's mean over the part behind the front
 (their fluid pressure is then the unknown of their mass balance, newton.py), only that part leaks (``fill``,
 the wetted fraction; the leak-off clock runs per wetted area), and the front is placed by the level set
-from the ribbon cells' inverted widths. Each step iterates solve -> front -> solve until the front's
-position at every tip cell reproduces itself (``_front_iterations``); cells the front enters become tip
-cells, cells it has crossed join the channel. This removes the whole-ring openings that, in leak-off
-dominated growth, starve the fracture after each opening (case IV: inlet width -57 % -> -9 %). The time step
-follows the measured front advance (Eq. 35 with V_T = advance / dt). Coarsening makes every coarse cell a
-channel cell; the next step places the front again.
+from the ribbon cells' inverted widths, with the viscous asymptote's V at least the front's own speed
+over the step, (s - s_0) / dt (s_0: the ribbon's distance at the step's start, kept in ``advance``).
+Each step iterates solve -> front -> solve until the front's position at every tip cell reproduces itself
+(``_front_iterations``); cells the front enters become tip cells, cells it has crossed join the channel
+once the step is accepted. This removes the whole-ring openings that, in leak-off dominated growth, starve
+the fracture after each opening (case IV: inlet width -57 % -> +2.9 %). The time step follows the measured
+front advance (Eq. 35 with V_T = advance / dt). Coarsening makes every coarse cell a channel cell (s_0
+unknown); the next step places the front again.
 """
 
 from __future__ import annotations
@@ -58,7 +60,7 @@ from ..records import BalanceRecord, FractureSnapshot, GridFrame
 from .coarsen import coarsen
 from .config import FractureNumerics
 from .elasticity import ElasticityOperator
-from .front import DIRECTIONS, TipModel, cells_to_open, edge_cells, front_distances
+from .front import DIRECTIONS, TipModel, _shift, cells_to_open, edge_cells, front_distances
 from .leakoff import carter_demand, carter_volume
 from .lubrication import build_faces
 from .mesh import GROW, Grid
@@ -68,7 +70,7 @@ from .tip_cells import fill_and_width, level_set, ribbon_distances
 K_PRIME_FACTOR = math.sqrt(32.0 / math.pi)   # K' = sqrt(32/pi) K_Ic
 FRONT_ITERATIONS = 30
 FRONT_TOLERANCE = 1e-2
-MIN_STEP_FRACTION = 1e-12   # a step shorter than this fraction of the time stops the run
+MIN_STEP_FRACTION = 1e-9   # a step shorter than this fraction of the time stops the run
 
 
 def _check_scene(scene) -> None:
@@ -139,6 +141,10 @@ class _Brackets:
         with np.errstate(invalid="ignore", divide="ignore"):
             falsi = self.lo + self.r_lo * (self.hi - self.lo) / (self.r_lo - self.r_hi)
         return np.where(both, falsi, target)
+
+    def width(self) -> np.ndarray:
+        """|hi - lo| where both ends are known, inf elsewhere."""
+        return np.where(np.isfinite(self.lo) & np.isfinite(self.hi), np.abs(self.hi - self.lo), np.inf)
 
 
 class _Engine:
@@ -319,18 +325,27 @@ class _Engine:
         front's position at every tip cell reproduces itself, |F(a) - a| < FRONT_TOLERANCE cells (a = how far
         the front is past the cell's centre). F decreases with a (a wider tip leaves less fluid to the
         ribbon), so each cell's root is bracketed as the iterations go and found by regula falsi (Illinois)
-        inside its bracket, plain iteration a = F(a) until it has one. A cell the front enters becomes a tip
-        cell (active, its Carter opening time the step's middle); one it has crossed joins the channel (its
-        width unknown); either restarts the brackets."""
+        inside its bracket, plain iteration a = F(a) until it has one. The channel and its ribbon cells are
+        those of the step's start throughout the step (as in PyFrac's ILSA, Zia & Lecampion 2020): a cell the
+        front enters becomes a tip cell (active, its Carter opening time the step's middle, which restarts the
+        brackets), and one it crosses stays a pinned tip cell, wholly wetted, until the step is accepted. (Turning
+        crossed cells into channel cells within the step swapped their width from the asymptote's mean to the
+        elastic solution, a jump that made the front leap by most of a cell in radial case IV.) The ribbons'
+        distances take the step's own front speed (tip_cells.ribbon_distances with s_0 = their ``advance``
+        at the start), and the converged ones are kept there for the next step. An iterate
+        that puts the front more than twice ``max_front_advance`` past its start ends the iterations: the step
+        is redone shorter (the level set reaches LAYERS cells out, and pinning tip cells that far out in one
+        go can stop Newton)."""
         g = self.grid
         h = min(self.dx, self.dz)
-        was_tip = start["active"] & (start["fill"] < 1.0)
+        channel = start["active"] & (start["fill"] >= 1.0)
+        was_tip = start["active"] & ~channel
         floor = np.where(was_tip, start["advance"], -np.inf)
-        start_w = np.where(start["active"], start["w"], 0.0)   # a tip cell does not give back fluid
-        pinned_box = np.where(g["active"] & (g["fill"] < 1.0), g["w"], np.nan)
+        pinned_box = np.where(was_tip, g["w"], np.nan)
         advance = 0.0
-        last = None   # the previous iteration's widths on the box: Newton's first iterate
+        last = None        # the last solved widths on the box: Newton's first iterate
         bracket = _Brackets(g.shape)
+        s_start = np.where(channel, start["advance"], np.nan)   # the ribbons' distances at the start, if known
         for _ in range(FRONT_ITERATIONS):
             res = self._solve(dt, pinned_box[self.rows, self.cols], None if last is None else last[self.rows, self.cols])
             if not res.converged:
@@ -338,43 +353,69 @@ class _Engine:
             w_box, p_box = g["w"].copy(), g["p"].copy()
             w_box[self.rows, self.cols], p_box[self.rows, self.cols] = res.w, res.p
             last = np.where(g["active"], w_box, 0.0)
-            channel = g["active"] & (g["fill"] >= 1.0)
             s_rib, v_rib = ribbon_distances(self.tip, channel, w_box, p_box, self.kprime_box, self.cprime_box,
-                                            g["reached"], self.t + dt, self.dx, self.dz)
+                                            g["reached"], self.t + dt, self.dx, self.dz, (s_start, dt))
             target, nx, nz, src = level_set(s_rib, channel, self.dx, self.dz)
             cand = np.isfinite(target)
             target = np.where(cand, np.fmax(target, floor), np.nan)
             reach = -0.5 * (np.abs(nx) * self.dx + np.abs(nz) * self.dz)   # the front at the cell's nearest corner
             known = g["active"] & np.isfinite(g["advance"])
             now = np.where(known, g["advance"], reach)
-            live = cand & (known | (target > reach))
-            if float(np.max(np.abs(target - now)[live], initial=0.0)) < FRONT_TOLERANCE * h:
+            # how far each cell's front position is from reproducing itself; settled: a cell the front has
+            # not reached either way (both below reach: dry), or whose root the bracket holds to the
+            # tolerance (F may jump across its root)
+            gap = np.where(cand & (bracket.width() >= FRONT_TOLERANCE * h),
+                           np.abs(np.maximum(target, reach) - np.maximum(now, reach)), 0.0)
+            ribbon = np.isfinite(s_rib)
+            g["advance"][ribbon] = s_rib[ribbon]   # the ribbons' distances: the next step's s_0
+            if float(gap.max()) < FRONT_TOLERANCE * h:
                 return res, advance, True
             moved = np.where(cand, bracket.next(np.where(cand, now, 0.0), np.where(cand, target, 0.0), cand), np.nan)
-            ks = src[cand]
-            fill, width = fill_and_width(self.tip, moved[cand], nx[cand], nz[cand], self.kprime_box.ravel()[ks],
-                                         self.cprime_box.ravel()[ks], v_rib.ravel()[ks], self.dx, self.dz)
-            fill_box, width_box = np.zeros(g.shape), np.zeros(g.shape)
-            fill_box[cand], width_box[cand] = fill, width
-            tip = cand & (fill_box > 0.0)
-            crossed = tip & (fill_box >= 1.0)
-            entered = tip & ~g["active"]
-            advance = max(advance, float(np.max((moved - np.where(was_tip, floor, -0.5 * h))[tip], initial=0.0)))
-            if entered.any():
-                g.fields["active"] = g["active"] | entered
-                for name in ("opened", "reached", "filled"):
-                    g[name][entered] = self.t + 0.5 * dt
-                g["w"][entered] = 0.0
-            g["advance"][tip] = moved[tip]
-            g["fill"][tip] = fill_box[tip]
-            keep = tip & ~crossed
-            pinned_box = np.where(g["active"] & (g["fill"] < 1.0), pinned_box, np.nan)
-            pinned_box[keep] = np.maximum(width_box[keep], start_w[keep])   # entered cells: start_w = 0
-            if entered.any() or crossed.any():
-                self._rebuild()
+            advance, entered = self._place_front(moved, (cand, nx, nz, src, v_rib), pinned_box, was_tip, floor,
+                                                 dt)
+            if advance > 2.0 * self.num.max_front_advance * h:
+                break   # far past the limit already: the step will be redone shorter
+            if entered:
                 bracket = _Brackets(g.shape)
         res = self._solve(dt, pinned_box[self.rows, self.cols])   # the last front, on the last active set
         return res, advance, res.converged
+
+    def _place_front(self, moved: np.ndarray, geometry: tuple, pinned_box: np.ndarray, was_tip: np.ndarray,
+                     floor: np.ndarray, dt: float) -> tuple[float, bool]:
+        """Put the front ``moved`` past the centres of the level set's cells (``geometry``: those cells, the
+        normal, the ribbon each leans on, its tip velocity): their wetted fraction, ``advance`` and pinned
+        width (in ``pinned_box``, in place: the asymptote's mean, which may fall below the step's start width:
+        flooring it there, with tip cells now staying tips until crossed, held back fluid and stopped Newton in
+        radial case II); a cell the front enters (one next to an active cell: one layer per iteration, so a start whose
+        ribbons put the front two layers out, as the initial fracture's can, does not pin both at once and
+        stop Newton) becomes active with its Carter opening time at the step's middle.
+        Returns (the farthest the front now is past where it was at the step's start, in m; whether cells
+        entered)."""
+        g, h = self.grid, min(self.dx, self.dz)
+        cand, nx, nz, src, v_rib = geometry
+        ks = src[cand]
+        fill, width = fill_and_width(self.tip, moved[cand], nx[cand], nz[cand], self.kprime_box.ravel()[ks],
+                                     self.cprime_box.ravel()[ks], v_rib.ravel()[ks], self.dx, self.dz)
+        fill_box, width_box = np.zeros(g.shape), np.zeros(g.shape)
+        fill_box[cand], width_box[cand] = fill, width
+        beside = np.zeros(g.shape, bool)   # next to an active cell: the front enters one layer per iteration
+        for dk, di in DIRECTIONS:
+            beside |= _shift(g["active"], dk, di, False)
+        tip = cand & (fill_box > 0.0)
+        entered = tip & ~g["active"] & beside
+        if entered.any():
+            g.fields["active"] = g["active"] | entered
+            for name in ("opened", "reached", "filled"):
+                g[name][entered] = self.t + 0.5 * dt
+            g["w"][entered] = 0.0
+        update = cand & g["active"]   # an entered cell the front has left again keeps fill 0 and width 0
+        moved_by = float(np.max((moved - np.where(was_tip, floor, -0.5 * h))[update & tip], initial=0.0))
+        g["advance"][update] = moved[update]
+        g["fill"][update] = fill_box[update]
+        pinned_box[update] = width_box[update]
+        if entered.any():
+            self._rebuild()
+        return moved_by, bool(entered.any())
 
     def _use_grid(self, grid) -> None:
         self.grid = grid

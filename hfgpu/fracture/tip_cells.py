@@ -11,8 +11,9 @@ first-order upwind update of fast marching (Sethian 1996):
     (d - a)^2 / dx^2 + (d - b)^2 / dz^2 = 1,   a, b the smallest d of the x- and z-neighbours,
 
 (d = a + dx or b + dz where only one is known or the root falls below max(a, b)). The front is the plane
-d = 0 with normal grad d; a tip cell holds the tip asymptote w_a(-d) behind it, so its wetted fraction and
-mean width are the cell averages of [d < 0] and w_a(max(-d, 0)) over QUADRATURE x QUADRATURE points.
+d = 0 with normal grad d; a tip cell holds the tip asymptote w_a(-d) behind it, so its wetted fraction is
+the exact area behind the plane (``wetted_fraction``) and its mean width the cell average of w_a(max(-d, 0))
+over QUADRATURE x QUADRATURE midpoints (``fill_and_width``).
 Here ``advance`` = -d at a cell's centre: how far the front is past the centre (negative: not yet there).
 """
 
@@ -24,29 +25,57 @@ from .front import OLSON, TipModel, _per_direction, _shift, _tip_cells, invert_t
 
 QUADRATURE = 8
 _OFFSETS = (np.arange(QUADRATURE) + 0.5) / QUADRATURE - 0.5
+LAYERS = 3   # cells marched out from the ribbons: the front may cross cells within a step (max_front_advance)
 
 
 def ribbon_distances(model: TipModel, channel: np.ndarray, w: np.ndarray, p: np.ndarray, k_prime: np.ndarray,
-                     c_prime: np.ndarray, reached: np.ndarray, t: float, dx: float, dz: float):
+                     c_prime: np.ndarray, reached: np.ndarray, t: float, dx: float, dz: float,
+                     start: tuple[np.ndarray, float] | None = None):
     """(s, V): at every ribbon cell the distance s from its centre to the front (front.invert_tip with K'
-    itself) and the tip velocity V used (the fastest of ``front.tip_velocity`` over the sides it faces
-    non-channel cells); NaN elsewhere."""
+    itself) and the tip velocity V of the viscous asymptote, the fastest of ``front.tip_velocity`` over the
+    sides the cell faces non-channel cells; NaN elsewhere. With ``start`` = (s_0, dt), the ribbons' distances
+    at the step's start (NaN: unknown) and the step, V is at least the front's own speed over the step,
+    V = max(V, (s - s_0) / dt) (as PyFrac's ILSA; ``_implicit_distance``): on an iterate whose inflow velocity
+    is ~0 at some ribbon, V alone let the viscous asymptote put the front tens of cells out in a short step."""
     masks, _, vel = _tip_cells(model, channel, w, p, reached, t, dx, dz, box_edge=False)
     v = np.full(w.shape, np.nan)
     for mask, v_dir in zip(masks, _per_direction(vel, masks)):
         v[mask] = np.fmax(v[mask], v_dir)
     ribbon = np.isfinite(v)
     s = np.full(w.shape, np.nan)
-    s[ribbon] = invert_tip(model, k_prime[ribbon] * OLSON, c_prime[ribbon], w[ribbon], v[ribbon])
+    args = (model, k_prime[ribbon] * OLSON, c_prime[ribbon], w[ribbon])
+    s[ribbon] = invert_tip(*args, v[ribbon])
+    if start is not None:
+        s_0, dt = start
+        s[ribbon], v[ribbon] = _implicit_distance(args, s[ribbon], v[ribbon], s_0[ribbon], dt)
     return s, v
 
 
-def level_set(s: np.ndarray, channel: np.ndarray, dx: float, dz: float):
-    """(advance, nx, nz, source): for every non-channel cell next to a ribbon, -d at its centre from the
-    eikonal update (module docstring) with d = -s at the ribbons, the unit normal of the front (grad d,
-    pointing out of the fracture) and the flat index of the ribbon neighbour with the smallest d (whose
-    K', C' and V the tip asymptote uses); NaN / -1 elsewhere."""
-    d = np.where(np.isfinite(s), -s, np.inf)
+def _implicit_distance(args: tuple, s: np.ndarray, v: np.ndarray, s_0: np.ndarray, dt: float,
+                       iterations: int = 50) -> tuple[np.ndarray, np.ndarray]:
+    """(s, V) of ``ribbon_distances`` with V = max(v, (s - s_0) / dt): where s (at speed v) lies beyond
+    s_0 + v dt, the root of s = invert_tip(w, (s - s_0) / dt) between s_0 + v dt and s, by bisection (the
+    inverse falls as V rises, so the root is unique); unchanged elsewhere."""
+    fast = np.isfinite(s_0) & (s > s_0 + v * dt)
+    if not fast.any():
+        return s, v
+    base = s_0[fast]
+    lo, hi = base + v[fast] * dt, s[fast]
+    sub = tuple(a[fast] for a in args[1:])
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        beyond = invert_tip(args[0], *sub, (mid - base) / dt) < mid
+        hi, lo = np.where(beyond, mid, hi), np.where(beyond, lo, mid)
+    s, v = s.copy(), v.copy()
+    s[fast] = 0.5 * (lo + hi)
+    v[fast] = (s[fast] - base) / dt
+    return s, v
+
+
+def _eikonal_layer(d: np.ndarray, frozen: np.ndarray, dx: float, dz: float):
+    """One layer of the eikonal update (module docstring): for every cell outside ``frozen`` whose d is not
+    known yet (inf) and that has a known 4-neighbour, (d, grad d = unit normal, flat index of the neighbour the
+    update leans on: the x- or z-neighbour with the smaller d); inf / NaN / -1 elsewhere."""
     flat = np.arange(d.size).reshape(d.shape)
     best = {}
     for axis, (dk, di) in (("x", (0, 1)), ("x", (0, -1)), ("z", (1, 0)), ("z", (-1, 0))):
@@ -57,8 +86,7 @@ def level_set(s: np.ndarray, channel: np.ndarray, dx: float, dz: float):
         take = near < a
         best[axis] = (np.where(take, near, a), np.where(take, src, a_src), np.where(take, sign, a_sign))
     (a, src_a, sign_a), (b, src_b, sign_b) = best["x"], best["z"]
-    cand = ~channel & (np.isfinite(a) | np.isfinite(b))
-    out = np.full(d.shape, np.nan)
+    cand = ~frozen & np.isinf(d) & (np.isfinite(a) | np.isfinite(b))
     a_f, b_f = np.where(np.isfinite(a), a, 0.0), np.where(np.isfinite(b), b, 0.0)
     both = np.isfinite(a) & np.isfinite(b)
     # (d - a)^2 / dx^2 + (d - b)^2 / dz^2 = 1, larger root
@@ -70,28 +98,75 @@ def level_set(s: np.ndarray, channel: np.ndarray, dx: float, dz: float):
         root = (-qb + np.sqrt(np.where(disc >= 0.0, disc, np.nan))) / (2.0 * qa)
     via_x = np.where(np.isfinite(a), a + dx, np.inf) <= np.where(np.isfinite(b), b + dz, np.inf)
     good = both & np.isfinite(root) & (root >= np.maximum(a_f, b_f))
-    dist = np.where(good, root, np.where(via_x, a + dx, b + dz))
-    out[cand] = -dist[cand]
+    dist = np.where(cand, np.where(good, root, np.where(via_x, a + dx, b + dz)), np.inf)
     gx = np.where(good, (dist - a_f) / dx, np.where(via_x, 1.0, 0.0)) * sign_a
     gz = np.where(good, (dist - b_f) / dz, np.where(via_x, 0.0, 1.0)) * sign_b
     with np.errstate(invalid="ignore", divide="ignore"):
         norm = np.hypot(gx, gz)
-        nx, nz = gx / norm, gz / norm
-    source = np.where(good & (b < a) | ~good & ~via_x, src_b, src_a)
-    nx[~cand], nz[~cand] = np.nan, np.nan
-    source[~cand] = -1
+        nx, nz = np.where(cand, gx / norm, np.nan), np.where(cand, gz / norm, np.nan)
+    lean = np.where(cand, np.where(good & (b < a) | ~good & ~via_x, src_b, src_a), -1)
+    return dist, nx, nz, lean
+
+
+def level_set(s: np.ndarray, channel: np.ndarray, dx: float, dz: float, layers: int = LAYERS):
+    """(advance, nx, nz, source): for the non-channel cells up to ``layers`` cells out from the ribbons, -d at
+    their centres from the eikonal update (module docstring, marched outward one layer at a time) with
+    d = -s at the ribbons, the unit normal of the front (grad d, pointing out of the fracture) and the flat
+    index of the ribbon cell the update leans on (through the layers: whose K', C' and V the tip asymptote
+    uses); NaN / -1 elsewhere."""
+    d = np.where(np.isfinite(s), -s, np.inf)
+    source = np.where(np.isfinite(s), np.arange(d.size).reshape(d.shape), -1)
+    out, nx, nz = (np.full(d.shape, np.nan) for _ in range(3))
+    for _ in range(layers):
+        dist, lx, lz, lean = _eikonal_layer(d, channel, dx, dz)
+        new = np.isfinite(dist)
+        if not new.any():
+            break
+        d[new], out[new], nx[new], nz[new] = dist[new], -dist[new], lx[new], lz[new]
+        source[new] = source.ravel()[lean[new]]
+    source[np.isnan(out)] = -1
     return out, nx, nz, source
+
+
+def _spread(nx: np.ndarray, nz: np.ndarray, dx: float, dz: float):
+    """Widths P = |n_x| dx, Q = |n_z| dz of the two uniform variables whose sum is n.(x - x_c) over the cell
+    (each at least 1e-7 of the cell: a front along the grid then errs by 1e-7 relative)."""
+    floor = 1e-7 * min(dx, dz)
+    return np.maximum(np.abs(nx) * dx, floor), np.maximum(np.abs(nz) * dz, floor)
+
+
+def wetted_fraction(advance: np.ndarray, nx: np.ndarray, nz: np.ndarray, dx: float, dz: float) -> np.ndarray:
+    """Exact part of a dx x dz cell behind the plane front d(x) = -advance + n.(x - x_c), the area where
+    sigma = n.(x - x_c) < advance: the distribution function of sigma, the sum of two uniform variables of
+    widths P and Q (``_spread``), a piecewise quadratic in y = advance + (P + Q)/2,
+
+        f = [y+^2 - (y - P)+^2 - (y - Q)+^2 + (y - P - Q)+^2] / (2 P Q).
+
+    It is exactly 0 before the cell's nearest corner and 1 past the farthest."""
+    p, q = _spread(nx, nz, dx, dz)
+    y = advance + 0.5 * (p + q)
+    g = lambda u: np.maximum(u, 0.0) ** 2
+    f = np.clip((g(y) - g(y - p) - g(y - q) + g(y - p - q)) / (2.0 * p * q), 0.0, 1.0)
+    return np.where(y >= p + q, 1.0, np.where(y <= 0.0, 0.0, f))
 
 
 def fill_and_width(model: TipModel, advance: np.ndarray, nx: np.ndarray, nz: np.ndarray, k_prime: np.ndarray,
                    c_prime: np.ndarray, v: np.ndarray, dx: float, dz: float) -> tuple[np.ndarray, np.ndarray]:
-    """Wetted fraction and mean width of cells crossed by the plane front d(x) = -advance + n.(x - x_c):
-    the averages of [d < 0] and of the tip asymptote w_a(-d) (front.tip_width with K' itself) over
-    QUADRATURE^2 points of the cell (1-D arrays, one entry per cell)."""
+    """Wetted fraction (``wetted_fraction``) and mean width of cells crossed by the plane front
+    d(x) = -advance + n.(x - x_c): the cell average of the tip asymptote w_a(-d) (front.tip_width with K'
+    itself) over QUADRATURE^2 midpoints, 0 outside the front (1-D arrays, one entry per cell). A cell wetted
+    short of its nearest midpoint gets its wetted fraction times w_a at a third of the front's distance past
+    the nearest corner (the depth of a corner triangle's centroid) instead of 0: a pinned cell of zero width
+    between dry neighbours would leave its pressure undetermined."""
     ox, oz = np.meshgrid(_OFFSETS * dx, _OFFSETS * dz)
     d = -advance[:, None] + nx[:, None] * ox.ravel()[None, :] + nz[:, None] * oz.ravel()[None, :]
     inside = d < 0.0
     n = d.shape[1]
-    wa = tip_width(model, np.repeat(k_prime * OLSON, n), np.repeat(c_prime, n), np.maximum(-d, 0.0).ravel(),
+    k_olson = k_prime * OLSON
+    wa = tip_width(model, np.repeat(k_olson, n), np.repeat(c_prime, n), np.maximum(-d, 0.0).ravel(),
                    np.repeat(v, n)).reshape(d.shape)
-    return inside.mean(axis=1), np.where(inside, wa, 0.0).mean(axis=1)
+    fill = wetted_fraction(advance, nx, nz, dx, dz)
+    width = np.where(inside, wa, 0.0).mean(axis=1)
+    corner = advance + 0.5 * (np.abs(nx) * dx + np.abs(nz) * dz)
+    first = fill * tip_width(model, k_olson, c_prime, np.maximum(corner, 0.0) / 3.0, v)
+    return fill, np.where(inside.any(axis=1), width, first)
