@@ -70,6 +70,13 @@ def divergence_matrix(faces: Faces, t: np.ndarray, n: int) -> scipy.sparse.csr_m
     return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(n, n))
 
 
+def net_inflow(faces: Faces, t: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """L p of ``divergence_matrix`` without assembling L: each face's T (p_b - p_a) added to cell a and taken
+    from cell b."""
+    flux = t * (p[faces.b] - p[faces.a])
+    return np.bincount(faces.a, flux, p.size) - np.bincount(faces.b, flux, p.size)
+
+
 def face_fluxes(faces: Faces, w: np.ndarray, p: np.ndarray) -> np.ndarray:
     """Volume rate through each face from b to a, T (p_b - p_a) [m^3/s] (Eq. 23)."""
     t = conductance(faces, w)[0]

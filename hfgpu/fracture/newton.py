@@ -48,7 +48,7 @@ from scipy.sparse.linalg import LinearOperator
 from .elasticity import ElasticityOperator
 from .krylov import gmres_solve, splu_preconditioner
 from .leakoff import available_fraction
-from .lubrication import Faces, conductance, divergence_matrix
+from .lubrication import Faces, conductance, divergence_matrix, net_inflow
 
 MONOTONICITY_HALVINGS = 10
 CONTACT_PASSES = 6
@@ -126,8 +126,8 @@ class Residual(NamedTuple):
     f: np.ndarray        # the residual, volume per cell over the step [m^3]
     w: np.ndarray        # widths (``_split``: held cells at held_width)
     p: np.ndarray        # fluid pressures
-    lap: scipy.sparse.csr_matrix   # the lubrication operator L(w)
-    dt_dw: list          # the face conductances' derivatives
+    t: np.ndarray        # the face conductances T(w) (the lubrication operator L(w): divergence_matrix)
+    dt_dw: list          # their derivatives
     g: np.ndarray        # the leaked fraction of the Carter demand (leak_fraction)
     dg: np.ndarray       # and its derivative
 
@@ -137,10 +137,10 @@ def residual(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.n
     ramp."""
     w, p = _split(prob, elastic, x, closed)
     t, *dt_dw = conductance(prob.faces, w, prob.w_smooth)
-    lap = divergence_matrix(prob.faces, t, w.size)
     g, dg = leak_fraction(prob, w)
-    f = (prob.area * (w - prob.w_old) + prob.area * prob.demand * g - prob.dt * (lap @ p) - prob.source)
-    return Residual(f, w, p, lap, dt_dw, g, dg)
+    f = (prob.area * (w - prob.w_old) + prob.area * prob.demand * g - prob.dt * net_inflow(prob.faces, t, p)
+         - prob.source)
+    return Residual(f, w, p, t, dt_dw, g, dg)
 
 
 def _conductance_jacobian(prob: StepProblem, w: np.ndarray, p: np.ndarray,
@@ -160,7 +160,8 @@ def dense_jacobian(prob: StepProblem, elastic: Elasticity, x: np.ndarray,
     """The analytic Jacobian dF/dx of Eq. 29 (with Eq. 28 eliminated) as a dense matrix."""
     closed = np.zeros(x.size, bool) if closed is None else closed
     r = residual(prob, elastic, x, closed)
-    return _dense(prob, elastic, r.lap, _conductance_jacobian(prob, r.w, r.p, r.dt_dw),
+    return _dense(prob, elastic, divergence_matrix(prob.faces, r.t, x.size),
+                  _conductance_jacobian(prob, r.w, r.p, r.dt_dw),
                   prob.area * (1.0 + prob.demand * r.dg), closed)
 
 
@@ -209,13 +210,14 @@ def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nd
     for it in range(1, max_iterations + 1):
         diag = prob.area * (1.0 + prob.demand * r.dg)
         cond = _conductance_jacobian(prob, r.w, r.p, r.dt_dw)
+        lap = divergence_matrix(prob.faces, r.t, x.size)
         try:
             if elastic.matrix is not None:
-                lu = scipy.linalg.lu_factor(_dense(prob, elastic, r.lap, cond, diag, closed), check_finite=False)
+                lu = scipy.linalg.lu_factor(_dense(prob, elastic, lap, cond, diag, closed), check_finite=False)
                 dx = scipy.linalg.lu_solve(lu, -r.f)
                 inverse = partial(scipy.linalg.lu_solve, lu)
             else:
-                dx, inverse = _krylov_update(prob, elastic, r.f, r.lap, cond, diag,
+                dx, inverse = _krylov_update(prob, elastic, r.f, lap, cond, diag,
                                              min(1e-3, tolerance * 1e-1), closed)
         except (np.linalg.LinAlgError, ValueError):
             return x, False, it

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from hfgpu.fracture.lubrication import build_faces, conductance, divergence_matrix, face_fluxes
+from hfgpu.fracture.lubrication import build_faces, conductance, divergence_matrix, face_fluxes, net_inflow
 
 
 def _block(nx, nz):
@@ -51,3 +51,5 @@ def test_divergence_conserves_volume_and_ignores_inactive_neighbours():
     lap = divergence_matrix(faces, t, ix.size)
     np.testing.assert_allclose(np.asarray(lap.sum(axis=0)).ravel(), 0.0, atol=1e-12 * t.max())   # columns: conservation
     np.testing.assert_allclose(np.asarray(lap.sum(axis=1)).ravel(), 0.0, atol=1e-12 * t.max())   # uniform p: no flow
+    p = rng.uniform(1e6, 2e6, ix.size)   # the residual's assembly-free L p equals the matrix's
+    np.testing.assert_allclose(net_inflow(faces, t, p), lap @ p, rtol=1e-12, atol=1e-12 * np.abs(lap @ p).max())
