@@ -36,6 +36,7 @@ the part of it behind the front.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from functools import partial
 from typing import NamedTuple
@@ -213,13 +214,15 @@ def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nd
         lap = divergence_matrix(prob.faces, r.t, x.size)
         try:
             if elastic.matrix is not None:
-                lu = scipy.linalg.lu_factor(_dense(prob, elastic, lap, cond, diag, closed), check_finite=False)
+                with warnings.catch_warnings():   # a singular Jacobian fails the iteration (the step is retried)
+                    warnings.simplefilter("error", scipy.linalg.LinAlgWarning)
+                    lu = scipy.linalg.lu_factor(_dense(prob, elastic, lap, cond, diag, closed), check_finite=False)
                 dx = scipy.linalg.lu_solve(lu, -r.f)
                 inverse = partial(scipy.linalg.lu_solve, lu)
             else:
                 dx, inverse = _krylov_update(prob, elastic, r.f, lap, cond, diag,
                                              min(1e-3, tolerance * 1e-1), closed)
-        except (np.linalg.LinAlgError, ValueError):
+        except (np.linalg.LinAlgError, ValueError, scipy.linalg.LinAlgWarning):
             return x, False, it
         if not np.all(np.isfinite(dx)):
             return x, False, it
