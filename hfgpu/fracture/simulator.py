@@ -71,6 +71,8 @@ K_PRIME_FACTOR = math.sqrt(32.0 / math.pi)   # K' = sqrt(32/pi) K_Ic
 FRONT_ITERATIONS = 30
 FRONT_TOLERANCE = 1e-2
 MIN_STEP_FRACTION = 1e-9   # a step shorter than this fraction of the time stops the run
+FAILED_STEP_MARGIN = 0.8     # the next steps stay below this fraction of the last step whose Newton failed ...
+FAILED_STEP_RELEASE = 1.02  # ... a bound that grows by this factor with every accepted step
 
 
 def _check_scene(scene) -> None:
@@ -198,6 +200,7 @@ class _Engine:
         self.t_front = self.t0
         self.steps = self.newton_iterations = self.retries = self.rejected = self.coarsenings = 0
         self.v_tip = 0.0
+        self.dt_failed = math.inf   # the last step whose Newton failed, released step by step (next_dt)
         self.max_balance_error = 0.0
         g["fill"][act] = 1.0
 
@@ -243,6 +246,7 @@ class _Engine:
                 self._newton_failed(res, dt)
             else:
                 self.retries += 1
+                self.dt_failed = dt
             dt *= 0.5
         self._accept(res, dt, advance)
         self._advance_front()
@@ -291,6 +295,7 @@ class _Engine:
         g["leaked"][sel] = g["leaked"][sel] + res.leaked / self.area
         self.leaked_total += float(res.leaked.sum())
         self.v_tip = advance / dt
+        self.dt_failed *= FAILED_STEP_RELEASE
         self.steps += 1
 
     # -- sub-grid front (front_tracking = "subgrid") ------------------------------------------------
@@ -312,6 +317,8 @@ class _Engine:
                 self._newton_failed(res, dt)
             self.retries += not ok
             self.rejected += ok
+            if not ok:
+                self.dt_failed = dt
             self._use_grid(start.copy())
             dt *= 0.5
         self._accept(res, dt, advance)
@@ -492,13 +499,16 @@ class _Engine:
     def next_dt(self, dt_prev: float) -> float:
         """Eq. 35, dt = lambda min(dx, dz) / V_T, with V_T the larger of the latest opening's front speed
         (Eq. 34; no larger than h / (time since that opening)) and the sub-grid front's measured speed over
-        the last step, and growth limited by max_step_growth."""
+        the last step, and growth limited by max_step_growth and by FAILED_STEP_MARGIN times the last step
+        whose Newton failed (that bound growing by FAILED_STEP_RELEASE a step: without it the sub-grid front
+        grew each step by 1.5 into a failure and a halved retry, every second step in radial case II)."""
         h = min(self.dx, self.dz)
         v = self.v_front
         if self.t > self.t_front:
             v = min(v, h / (self.t - self.t_front))
         v = max(v, self.v_tip, 1e-300)
-        return min(self.num.time_step_relaxation * h / v, self.num.max_step_growth * dt_prev)
+        return min(self.num.time_step_relaxation * h / v, self.num.max_step_growth * dt_prev,
+                   FAILED_STEP_MARGIN * self.dt_failed)
 
     # ------------------------------------------------------------------------------------------
     def balance(self) -> BalanceRecord:
@@ -556,7 +566,7 @@ class _Engine:
     # -- checkpoints ------------------------------------------------------------------------------
     #: Attributes (numbers or arrays) a checkpoint carries besides the grid: list every new persistent one here.
     STATE_ATTRIBUTES = ("t", "t0", "v_front", "t_front", "leaked_total", "steps", "newton_iterations", "retries",
-                        "coarsenings", "max_balance_error", "v_tip", "rejected")
+                        "coarsenings", "max_balance_error", "v_tip", "rejected", "dt_failed")
 
     def state(self) -> dict:
         """Everything needed to continue from now (a checkpoint): STATE_ATTRIBUTES, the grid (placement and every
