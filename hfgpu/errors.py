@@ -7,6 +7,9 @@ class HfgpuError(Exception):
     """Base class of every error hfgpu raises on purpose."""
 
 
+SHOWN_VALUE = 32   # characters of a bad value's repr a SceneError shows
+
+
 class SceneError(HfgpuError, ValueError):
     """A scene value is missing, malformed or out of range.
 
@@ -18,6 +21,8 @@ class SceneError(HfgpuError, ValueError):
         self.value = value
         self.allowed = allowed
         shown = "(missing)" if value is _MISSING else repr(value)
+        if len(shown) > SHOWN_VALUE:   # a long value (a pasted table, a stray string) would bury the message
+            shown = shown[:SHOWN_VALUE - 3] + "..."
         super().__init__(f"scene key '{path}': got {shown}; {allowed}")
 
 

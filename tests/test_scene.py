@@ -171,3 +171,14 @@ def test_corrupted_values_raise_scene_error_only(changes):
         parse_scene(data)
     except SceneError as exc:
         assert "scene key '" in str(exc)
+
+
+def test_a_long_bad_value_is_shortened_in_the_message():
+    """A pasted value of hundreds of characters is shown by its first 29 and '...', so the one-line message
+    (key, value, what is allowed) stays readable; the error keeps the whole value."""
+    long = "x" * 500
+    with pytest.raises(SceneError) as caught:
+        load_scene(BASE.replace('youngs_modulus = "40 GPa"', f'youngs_modulus = "{long}"'))
+    message = str(caught.value)
+    assert "'rock.youngs_modulus'" in message and f"got '{'x' * 28}..." in message and len(message) < 200
+    assert caught.value.value == long
