@@ -245,8 +245,7 @@ class _Engine:
             elif attempt == self.num.max_step_retries:
                 self._newton_failed(res, dt)
             else:
-                self.retries += 1
-                self.dt_failed = dt
+                self._newton_retry(dt)
             dt *= 0.5
         self._accept(res, dt, advance)
         self._advance_front()
@@ -276,6 +275,12 @@ class _Engine:
                          None if w_start is None else np.where(w_start > 0.0, w_start, start_widths(prob)))
         self.newton_iterations += res.iterations
         return res
+
+    def _newton_retry(self, dt: float) -> None:
+        """Count a step of length dt whose Newton iteration failed and is redone shorter; the steps after it
+        stay below it (``dt_failed``, next_dt)."""
+        self.retries += 1
+        self.dt_failed = dt
 
     def _newton_failed(self, res, dt: float) -> None:
         worst = int(np.nanargmax(np.where(np.isfinite(res.residual), np.abs(res.residual), np.inf)))
@@ -315,10 +320,10 @@ class _Engine:
                 break
             if not ok and attempt == self.num.max_step_retries:
                 self._newton_failed(res, dt)
-            self.retries += not ok
-            self.rejected += ok
-            if not ok:
-                self.dt_failed = dt
+            if ok:
+                self.rejected += 1
+            else:
+                self._newton_retry(dt)
             self._use_grid(start.copy())
             dt *= 0.5
         self._accept(res, dt, advance)
