@@ -120,12 +120,15 @@ class TaichiBackend:
             pool.append(buf)
         return buf
 
-    def _deposit_buffer(self, key: str, n: int, shape: tuple[int, ...]) -> tuple[np.ndarray, int, bool]:
+    def _deposit_buffer(self, key: str, n: int, shape: tuple[int, ...], size: int | None = None
+                        ) -> tuple[np.ndarray, int, bool]:
         """Zeroed grid copies (copies, *shape) for a deposit of n parcels, the number of blocks, and whether
-        the copies are private to the blocks (CPU) or shared through atomics (GPU)."""
+        the copies are private to the blocks (CPU) or shared through atomics (GPU). ``size``: the elements per
+        copy that bound the number of private copies (default: those of ``shape``; a kernel depositing into
+        several grids passes the largest, so that every grid gets the same number of blocks)."""
         private = self.arch == "cpu"
         if private:
-            fit = max(1, self.PRIVATE_BYTES // (8 * int(np.prod(shape))))
+            fit = max(1, self.PRIVATE_BYTES // (8 * (size or int(np.prod(shape)))))
             blocks = max(1, min(self.PRIVATE_COPIES, fit, n // self.PARCELS_PER_COPY))
         else:
             blocks = -(-n // self._k.CHUNK)
@@ -206,18 +209,17 @@ class TaichiBackend:
     def exchange(self, parcels: Parcels, seen: ParcelFluid, drag: np.ndarray, frame: GridFrame,
                  width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Interphase momentum transfer per unit volume at faces (Eq. 39), blocked deposit."""
-        nz, nx = ref.check_width(width)
+        ref.check_width(width)
         _, xmask, zmask = active_nodes(width)
-        sums = []
-        flags = self._flags(width)
-        for key, mask, along_x in (("xface", xmask, True), ("zface", zmask, False)):
-            buf, blocks, private = self._deposit_buffer(key, parcels.n, mask.shape + (1,))
-            if parcels.n:
-                self._k.exchange_sums(parcels.x, parcels.z, parcels.u, parcels.v, parcels.radius,
-                                      parcels.density, parcels.particles, seen.fluid_u, seen.fluid_v, seen.dpdx,
-                                      seen.dpdz, drag, frame.x0, frame.z0, frame.dx, frame.dz, mask, flags,
-                                      along_x, blocks, private, buf)
-            sums.append(buf.sum(axis=0)[..., 0])
+        size = max(xmask.size, zmask.size)
+        buf_x, blocks, private = self._deposit_buffer("xface", parcels.n, xmask.shape + (1,), size)
+        buf_z, _, _ = self._deposit_buffer("zface", parcels.n, zmask.shape + (1,), size)
+        if parcels.n:
+            self._k.exchange_sums(parcels.x, parcels.z, parcels.u, parcels.v, parcels.radius, parcels.density,
+                                  parcels.particles, seen.fluid_u, seen.fluid_v, seen.dpdx, seen.dpdz, drag,
+                                  frame.x0, frame.z0, frame.dx, frame.dz, xmask, zmask, self._flags(width), blocks,
+                                  private, buf_x, buf_z)
+        sums = [buf_x.sum(axis=0)[..., 0], buf_z.sum(axis=0)[..., 0]]
         wxf, wzf = face_widths(width)
         return ref.per_face_volume(sums[0], frame, wxf), ref.per_face_volume(sums[1], frame, wzf)
 

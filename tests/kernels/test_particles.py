@@ -127,6 +127,26 @@ def test_sorting_changes_no_result(taichi_backend):
     close(np.sort(ordered.v), np.sort(parcels.v))
 
 
+@pytest.mark.parametrize("private_bytes, cell_copies, face_copies", [(64 * 2 ** 20, 15, 15), (8 * 216 * 5, 1, 4)])
+def test_deposits_in_many_private_copies_match_numpy(numpy_backend, private_bytes, cell_copies, face_copies):
+    """The CPU deposits split the parcels into blocks, each summing into its own grid copy: 3000 parcels at
+    200 per copy give 15 copies (the most is 16). A budget of 5 copies of the 216-face x grid (12 x 18) fits
+    4 of the 221-face z grid (13 x 17): the exchange, one kernel for both, gives both 4 blocks; the 7-channel
+    cell grid gets 1."""
+    backend = get_backend("taichi", arch="cpu")
+    backend.PARCELS_PER_COPY, backend.PRIVATE_BYTES = 200, private_bytes
+    frame, width, parcels, fluid = random_case(seed=3)
+    params = MppicParams()
+    ra = run_step(backend, frame, width, parcels.copy(), fluid, params)
+    rb = run_step(numpy_backend, frame, width, parcels.copy(), fluid, params)
+    assert backend._copies["cell"].shape[0] == cell_copies
+    assert backend._copies["xface"].shape[0] == backend._copies["zface"].shape[0] == face_copies
+    for name in ra[0].__dataclass_fields__:
+        close(getattr(ra[0], name), getattr(rb[0], name))
+    for fa, fb in zip(ra[3], rb[3]):
+        close(fa, fb)
+
+
 @pytest.mark.parametrize("backend_name", ["numpy", "taichi"])
 def test_exchange_is_equal_and_opposite(backend_name, taichi_backend, numpy_backend):
     """sum F V_face == sum over parcels n rho_p V_p [D (u_f - u_p) - grad p / rho_p] (Eq. 39)."""
