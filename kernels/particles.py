@@ -260,6 +260,25 @@ def flush(out: ti.template(), copy: ti.i32, k0: ti.i32, i0: ti.i32, acc: ti.temp
                         ti.atomic_add(out[copy, k0 + a, i0 + b, c], acc[2 * a + b, c])
 
 
+NO_RUN = -2  # stencil base of "no run yet": bilinear bases are >= -1 for points inside the grid (a parcel in
+#            the upper-left quarter of the first cell has base (-1, -1))
+
+
+@ti.func
+def run_sum(out: ti.template(), copy: ti.i32, k0: ti.i32, i0: ti.i32, kb: ti.i32, ib: ti.i32, acc,
+            nch: ti.template(), private: ti.template()):
+    """Run-local summation of the deposits: when the next parcel's stencil base (k0, i0) differs from the
+    run's (kb, ib), flush the run's sums (unless there is no run yet, kb = NO_RUN) and start a new run at (k0,
+    i0). Returns the run's (acc, kb, ib)."""
+    if k0 != kb or i0 != ib:
+        if kb != NO_RUN:
+            flush(out, copy, kb, ib, acc, nch, private)
+        acc = ti.Matrix.zero(ti.f64, 4, nch)
+        kb = k0
+        ib = i0
+    return acc, kb, ib
+
+
 @ti.func
 def block_range(block: ti.i32, blocks: ti.i32, n: ti.i32, private: ti.template()):
     """Parcels [start, end) of a deposit block: ``blocks`` near-equal ranges (private copies) or CHUNK."""
@@ -288,16 +307,11 @@ def moment_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles: 
         copy = block if ti.static(private) else 0
         start, end = block_range(block, blocks, n, private)
         acc = ti.Matrix.zero(ti.f64, 4, 7)
-        kb = -1
-        ib = -1
+        kb = NO_RUN
+        ib = NO_RUN
         for p in range(start, end):
             k0, i0, w = deposit_weights((x[p] - x0) / dx, (z[p] - z0) / dz, 0.0, 0.0, cell_mask, flags)
-            if k0 != kb or i0 != ib:
-                if kb != -1 or ib != -1:
-                    flush(out, copy, kb, ib, acc, 7, private)
-                acc = ti.Matrix.zero(ti.f64, 4, 7)
-                kb = k0
-                ib = i0
+            acc, kb, ib = run_sum(out, copy, k0, i0, kb, ib, acc, 7, private)
             r = radius[p]
             vol = particles[p] * (4.0 / 3.0 * PI * r ** 3)
             mass = vol * density[p]
@@ -306,7 +320,7 @@ def moment_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles: 
             for j in ti.static(range(4)):
                 for c in ti.static(range(7)):
                     acc[j, c] += vals[c] * w[j]
-        if kb != -1 or ib != -1:
+        if kb != NO_RUN:
             flush(out, copy, kb, ib, acc, 7, private)
 
 
@@ -649,32 +663,22 @@ def exchange_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles
         start, end = block_range(block, blocks, n, private)
         acc_x = ti.Matrix.zero(ti.f64, 4, 1)
         acc_z = ti.Matrix.zero(ti.f64, 4, 1)
-        kx = -1
-        ix = -1
-        kz = -1
-        iz = -1
+        kx = NO_RUN
+        ix = NO_RUN
+        kz = NO_RUN
+        iz = NO_RUN
         for p in range(start, end):
             sx = (x[p] - x0) / dx
             sz = (z[p] - z0) / dz
             k0, i0, w = deposit_weights(sx, sz, 0.5, 0.0, xface_mask, flags)
             k1, i1, w1 = deposit_weights(sx, sz, 0.0, 0.5, zface_mask, flags)
             fx, fz = face_forces(p, u, v, radius, density, particles, s_u, s_v, s_dpdx, s_dpdz, drag)
-            if k0 != kx or i0 != ix:
-                if kx != -1 or ix != -1:
-                    flush(out_x, copy, kx, ix, acc_x, 1, private)
-                acc_x = ti.Matrix.zero(ti.f64, 4, 1)
-                kx = k0
-                ix = i0
-            if k1 != kz or i1 != iz:
-                if kz != -1 or iz != -1:
-                    flush(out_z, copy, kz, iz, acc_z, 1, private)
-                acc_z = ti.Matrix.zero(ti.f64, 4, 1)
-                kz = k1
-                iz = i1
+            acc_x, kx, ix = run_sum(out_x, copy, k0, i0, kx, ix, acc_x, 1, private)
+            acc_z, kz, iz = run_sum(out_z, copy, k1, i1, kz, iz, acc_z, 1, private)
             for j in ti.static(range(4)):
                 acc_x[j, 0] += fx * w[j]
                 acc_z[j, 0] += fz * w1[j]
-        if kx != -1 or ix != -1:
+        if kx != NO_RUN:
             flush(out_x, copy, kx, ix, acc_x, 1, private)
-        if kz != -1 or iz != -1:
+        if kz != NO_RUN:
             flush(out_z, copy, kz, iz, acc_z, 1, private)
