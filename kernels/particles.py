@@ -129,13 +129,13 @@ def cell_flags(k: ti.i32, i: ti.i32, nz: ti.i32, nx: ti.i32, width: ti.template(
 
 @ti.func
 def deposit_weights(sx: ti.f64, sz: ti.f64, ox: ti.template(), oz: ti.template(), mask: ti.template(),
-                    flags: ti.template()):
-    """bilinear at (sx + ox, sz + oz) onto ``mask`` for a parcel at cell coordinates (sx, sz): plain weights
-    where its cell is INTERIOR."""
+                    flag: ti.i32):
+    """bilinear at (sx + ox, sz + oz) onto ``mask`` for a parcel at cell coordinates (sx, sz) whose cell has
+    the stencil_flags ``flag`` (owner_flags): plain weights where it is INTERIOR."""
     k0 = ti.cast(0, ti.i32)
     i0 = ti.cast(0, ti.i32)
     w = ti.Vector.zero(ti.f64, 4)
-    if owner_flags(sx, sz, flags) & INTERIOR:
+    if flag & INTERIOR:
         k0, i0, w = bilinear(sx + ox, sz + oz, mask, True)
     else:
         k0, i0, w = bilinear(sx + ox, sz + oz, mask, False)
@@ -244,35 +244,34 @@ def packed_gain(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cell_mask: ti.
     return out
 
 
+NO_RUN = -2  # stencil base of "no run yet": bilinear bases are >= -1 for points inside the grid (a parcel in
+#            the upper-left quarter of the first cell has base (-1, -1))
+
+
 @ti.func
 def flush(out: ti.template(), copy: ti.i32, k0: ti.i32, i0: ti.i32, acc: ti.template(), nch: ti.template(),
           private: ti.template()):
     """Add the locally summed 2 x 2 x nch block acc onto out[copy] (copies, nz, nx, channels) at base (k0, i0):
-    plainly where the copy is private to this task, else with atomics; blocks that sum to exactly 0 (every
-    node outside the grid or inactive carries 0) are skipped."""
-    for a in ti.static(range(2)):
-        for b in ti.static(range(2)):
-            for c in ti.static(range(nch)):
-                if acc[2 * a + b, c] != 0.0:
-                    if ti.static(private):
-                        out[copy, k0 + a, i0 + b, c] = out[copy, k0 + a, i0 + b, c] + acc[2 * a + b, c]
-                    else:
-                        ti.atomic_add(out[copy, k0 + a, i0 + b, c], acc[2 * a + b, c])
-
-
-NO_RUN = -2  # stencil base of "no run yet": bilinear bases are >= -1 for points inside the grid (a parcel in
-#            the upper-left quarter of the first cell has base (-1, -1))
+    plainly where the copy is private to this task, else with atomics; nothing at base NO_RUN (no run yet);
+    blocks that sum to exactly 0 (every node outside the grid or inactive carries 0) are skipped."""
+    if k0 != NO_RUN:
+        for a in ti.static(range(2)):
+            for b in ti.static(range(2)):
+                for c in ti.static(range(nch)):
+                    if acc[2 * a + b, c] != 0.0:
+                        if ti.static(private):
+                            out[copy, k0 + a, i0 + b, c] = out[copy, k0 + a, i0 + b, c] + acc[2 * a + b, c]
+                        else:
+                            ti.atomic_add(out[copy, k0 + a, i0 + b, c], acc[2 * a + b, c])
 
 
 @ti.func
 def run_sum(out: ti.template(), copy: ti.i32, k0: ti.i32, i0: ti.i32, kb: ti.i32, ib: ti.i32, acc,
             nch: ti.template(), private: ti.template()):
     """Run-local summation of the deposits: when the next parcel's stencil base (k0, i0) differs from the
-    run's (kb, ib), flush the run's sums (unless there is no run yet, kb = NO_RUN) and start a new run at (k0,
-    i0). Returns the run's (acc, kb, ib)."""
+    run's (kb, ib), flush the run's sums and start a new run at (k0, i0). Returns the run's (acc, kb, ib)."""
     if k0 != kb or i0 != ib:
-        if kb != NO_RUN:
-            flush(out, copy, kb, ib, acc, nch, private)
+        flush(out, copy, kb, ib, acc, nch, private)
         acc = ti.Matrix.zero(ti.f64, 4, nch)
         kb = k0
         ib = i0
@@ -310,7 +309,9 @@ def moment_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles: 
         kb = NO_RUN
         ib = NO_RUN
         for p in range(start, end):
-            k0, i0, w = deposit_weights((x[p] - x0) / dx, (z[p] - z0) / dz, 0.0, 0.0, cell_mask, flags)
+            sx = (x[p] - x0) / dx
+            sz = (z[p] - z0) / dz
+            k0, i0, w = deposit_weights(sx, sz, 0.0, 0.0, cell_mask, owner_flags(sx, sz, flags))
             acc, kb, ib = run_sum(out, copy, k0, i0, kb, ib, acc, 7, private)
             r = radius[p]
             vol = particles[p] * (4.0 / 3.0 * PI * r ** 3)
@@ -320,8 +321,7 @@ def moment_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles: 
             for j in ti.static(range(4)):
                 for c in ti.static(range(7)):
                     acc[j, c] += vals[c] * w[j]
-        if kb != NO_RUN:
-            flush(out, copy, kb, ib, acc, 7, private)
+        flush(out, copy, kb, ib, acc, 7, private)
 
 
 @ti.func
@@ -670,15 +670,14 @@ def exchange_sums(x: F1, z: F1, u: F1, v: F1, radius: F1, density: F1, particles
         for p in range(start, end):
             sx = (x[p] - x0) / dx
             sz = (z[p] - z0) / dz
-            k0, i0, w = deposit_weights(sx, sz, 0.5, 0.0, xface_mask, flags)
-            k1, i1, w1 = deposit_weights(sx, sz, 0.0, 0.5, zface_mask, flags)
+            flag = owner_flags(sx, sz, flags)
+            k0, i0, w = deposit_weights(sx, sz, 0.5, 0.0, xface_mask, flag)
+            k1, i1, w1 = deposit_weights(sx, sz, 0.0, 0.5, zface_mask, flag)
             fx, fz = face_forces(p, u, v, radius, density, particles, s_u, s_v, s_dpdx, s_dpdz, drag)
             acc_x, kx, ix = run_sum(out_x, copy, k0, i0, kx, ix, acc_x, 1, private)
             acc_z, kz, iz = run_sum(out_z, copy, k1, i1, kz, iz, acc_z, 1, private)
             for j in ti.static(range(4)):
                 acc_x[j, 0] += fx * w[j]
                 acc_z[j, 0] += fz * w1[j]
-        if kx != NO_RUN:
-            flush(out_x, copy, kx, ix, acc_x, 1, private)
-        if kz != NO_RUN:
-            flush(out_z, copy, kz, iz, acc_z, 1, private)
+        flush(out_x, copy, kx, ix, acc_x, 1, private)
+        flush(out_z, copy, kz, iz, acc_z, 1, private)

@@ -219,9 +219,9 @@ class TaichiBackend:
                                   parcels.particles, seen.fluid_u, seen.fluid_v, seen.dpdx, seen.dpdz, drag,
                                   frame.x0, frame.z0, frame.dx, frame.dz, xmask, zmask, self._flags(width), blocks,
                                   private, buf_x, buf_z)
-        sums = [buf_x.sum(axis=0)[..., 0], buf_z.sum(axis=0)[..., 0]]
         wxf, wzf = face_widths(width)
-        return ref.per_face_volume(sums[0], frame, wxf), ref.per_face_volume(sums[1], frame, wzf)
+        return (ref.per_face_volume(buf_x.sum(axis=0)[..., 0], frame, wxf),
+                ref.per_face_volume(buf_z.sum(axis=0)[..., 0], frame, wzf))
 
     def momentum_predictor(self, u0: np.ndarray, v0: np.ndarray, p: np.ndarray, width0: np.ndarray,
                            theta_f0: np.ndarray, width: np.ndarray, theta_f: np.ndarray, mu: np.ndarray,
