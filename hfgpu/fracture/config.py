@@ -29,7 +29,7 @@ class FractureNumerics:
     partial_tip_cells: spread a newly opened cell's Carter opening time over the time the front takes to
         cross it (its parent's crossing time, Eq. 34), so leak-off follows the wetted part of the cell.
     max_front_advance: the most the sub-grid front may move in one step, in cells; a longer step is redone
-        with half the time step, so results do not depend on how far apart output times are.
+        with half the time step, so the front does not over-run on long steps.
     front_tracking: "cells" (a cell opens whole when its neighbour meets the front criterion, Eq. 33) or
         "subgrid" (tip cells: the front crosses the cells around the channel by a distance found from the
         channel's widths through the inverted tip asymptote, their widths are the asymptote's mean over the

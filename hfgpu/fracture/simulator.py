@@ -3,11 +3,12 @@
 Each step [t, t + dt] solves the implicit elasticity-lubrication-leak-off system for the widths of the
 active cells (Newton, :mod:`newton`), then opens the cells the front criterion selects (:mod:`front`) and
 chooses the next step by Eq. 35 with V_T the larger of the last opening's speed (Eq. 34) and the sub-grid
-front's measured speed over the step just taken. Steps land on schedule breakpoints, output times and the end
-time; a step whose Newton iteration fails, or in which the sub-grid front (front.front_distances) moved more
-than ``max_front_advance`` cells, is redone with half the step (``max_step_retries`` times; then a Newton
-failure raises SimulationError naming time, cell and residual, a long advance is accepted), so the front
-does not over-run on long steps and results do not depend on the output spacing. Cells squeezed shut stay
+front's measured speed over the step just taken. Steps land on schedule breakpoints and the end time (physics),
+never on output times: a snapshot between two accepted steps is interpolated between them (interpolate.py),
+so the steps and the results do not depend on the output spacing. A step whose Newton iteration fails, or in
+which the sub-grid front (front.front_distances) moved more than ``max_front_advance`` cells, is redone with
+half the step (``max_step_retries`` times; then a Newton failure raises SimulationError naming time, cell and
+residual, a long advance is accepted), so the front does not over-run on long steps. Cells squeezed shut stay
 closed at w = 0 (contact, newton.solve_step). The injected volume of a step is exact
 (Schedule.mean_rate), leak-off is Carter's law integrated exactly (:mod:`leakoff`), and the flux form
 conserves volume, so injected = stored + leaked to the Newton tolerance at every step.
@@ -50,6 +51,7 @@ unknown); the next step places the front again.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -61,6 +63,8 @@ from .coarsen import coarsen
 from .config import FractureNumerics
 from .elasticity import ElasticityOperator
 from .front import DIRECTIONS, TipModel, _shift, cells_to_open, edge_cells, front_distances
+from .geometry import filled_fraction, footprint
+from .interpolate import StepEnds
 from .leakoff import carter_demand, carter_volume
 from .lubrication import build_faces
 from .mesh import GROW, Grid
@@ -149,6 +153,18 @@ class _Brackets:
         return np.where(np.isfinite(self.lo) & np.isfinite(self.hi), np.abs(self.hi - self.lo), np.inf)
 
 
+@dataclass(frozen=True)
+class _View:
+    """A state of the run that a snapshot is made of: the grid, its time, the leaked total [m^3] and K', C' on
+    the grid's box."""
+
+    grid: Grid
+    t: float
+    leaked: float
+    kprime_box: np.ndarray
+    cprime_box: np.ndarray
+
+
 class _Engine:
     """Mutable state of one run (grid fields, active-set systems, counters)."""
 
@@ -202,6 +218,7 @@ class _Engine:
         self.v_tip = 0.0
         self.dt_failed = math.inf   # the last step whose Newton failed, released step by step (next_dt)
         self.max_balance_error = 0.0
+        self.ends: StepEnds | None = None   # the last step's two ends, when asked for (step's keep_ends)
         g["fill"][act] = 1.0
 
     def _properties(self) -> None:
@@ -225,12 +242,14 @@ class _Engine:
         self.inj = int(np.flatnonzero((self.ix == 0) & (self.iz == 0))[0])
 
     # ------------------------------------------------------------------------------------------
-    def step(self, dt: float) -> float:
+    def step(self, dt: float, keep_ends: bool = False) -> float:
         """Advance by dt; returns the step taken. A step whose Newton iteration fails, or in which the front
-        moves more than ``max_front_advance`` cells (``_front_advance``), is redone with half the step."""
+        moves more than ``max_front_advance`` cells (``_front_advance``), is redone with half the step. With
+        ``keep_ends`` the step's two ends are kept in ``ends`` (interpolate.StepEnds), else ``ends`` is None."""
         if self.num.front_tracking == "subgrid":
-            return self._step_subgrid(dt)
+            return self._step_subgrid(dt, keep_ends)
         g = self.grid
+        start = g.copy() if keep_ends else None
         sel = (self.rows, self.cols)
         w_old = g["w"][sel]
         reach_old = self._front_reach(g["w"], g["p"], self.t)
@@ -247,7 +266,7 @@ class _Engine:
             else:
                 self._newton_retry(dt)
             dt *= 0.5
-        self._accept(res, dt, advance)
+        self._accept(res, dt, advance, start)
         self._advance_front()
         return dt
 
@@ -288,11 +307,13 @@ class _Engine:
                               time=self.t + dt, cell=(int(self.ix[worst]), int(self.iz[worst])),
                               residual=float(np.abs(res.residual[worst]) / self.area))
 
-    def _accept(self, res, dt: float, advance: float) -> None:
-        """Store an accepted step's widths, pressures and leak-off and move the clock."""
+    def _accept(self, res, dt: float, advance: float, start: Grid | None) -> None:
+        """Store an accepted step's widths, pressures and leak-off and move the clock; with ``start`` (the grid
+        at the step's start) keep both ends in ``ends``."""
         if not (np.all(np.isfinite(res.w)) and np.all(np.isfinite(res.p))):
             raise SimulationError("non-finite width or pressure", time=self.t + dt)
         g, sel = self.grid, (self.rows, self.cols)
+        t_a, leaked_a = self.t, self.leaked_total
         self.t += dt
         g["w"][sel] = res.w
         g["p"][sel] = res.p
@@ -302,9 +323,11 @@ class _Engine:
         self.v_tip = advance / dt
         self.dt_failed *= FAILED_STEP_RELEASE
         self.steps += 1
+        self.ends = None if start is None else StepEnds(t_a, self.t, start, g.copy(), leaked_a, self.leaked_total,
+                                                        self.kprime_box, self.cprime_box)
 
     # -- sub-grid front (front_tracking = "subgrid") ------------------------------------------------
-    def _step_subgrid(self, dt: float) -> float:
+    def _step_subgrid(self, dt: float, keep_ends: bool) -> float:
         """One step with tip cells (module docstring): the front's position at the tip cells and the step's
         solution are iterated to a fixed point (``_front_iterations``). A step whose Newton iteration fails,
         or in which the front moves more than ``max_front_advance`` cells, is redone with half the step."""
@@ -326,7 +349,7 @@ class _Engine:
                 self._newton_retry(dt)
             self._use_grid(start.copy())
             dt *= 0.5
-        self._accept(res, dt, advance)
+        self._accept(res, dt, advance, start if keep_ends else None)
         self.v_front, self.t_front = self.v_tip, self.t
         self._coarsen_if_wide()
         return dt
@@ -521,51 +544,73 @@ class _Engine:
         return BalanceRecord(time=self.t, injected=self.schedule.volume(self.t), stored=stored,
                              leaked=self.leaked_total)
 
-    def snapshot(self) -> FractureSnapshot:
-        g = self.grid
+    def now(self) -> _View:
+        """The current state as a :class:`_View`."""
+        return _View(self.grid, self.t, self.leaked_total, self.kprime_box, self.cprime_box)
+
+    def between(self, t: float) -> _View:
+        """The state at a time t inside the last step, interpolated between its two ends (interpolate.py;
+        the step was taken with ``keep_ends``)."""
+        e = self.ends
+        return _View(e.state_at(t, self.t0), t, e.leaked(t), e.kprime_box, e.cprime_box)
+
+    def snapshot(self, view: _View, time: float) -> FractureSnapshot:
+        """The snapshot of ``view`` stamped ``time``: the fields on the footprint's bounding box plus one cell,
+        the front summary (``front_*``), the footprint's size (geometry.footprint) and the volume balance
+        (``injected_volume``, ``stored_volume``, ``leaked_volume``) as scalar extras."""
+        g = view.grid
         rs, cs = g.bounding_box(1)
         x, z = g.centres()
         act = g["active"][rs, cs]
-        frame = GridFrame(self.dx, self.dz, float(x[rs, cs][0, 0]), float(z[rs, cs][0, 0]))
+        width = np.where(act, g["w"][rs, cs], 0.0)
+        frame = GridFrame(g.dx, g.dz, float(x[rs, cs][0, 0]), float(z[rs, cs][0, 0]))
+        scalars = {f"front_{k}": v for k, v in self.front(view).items()} | self.geometry(view) | dict(
+            injected_volume=self.schedule.volume(view.t), stored_volume=float(width.sum()) * g.dx * g.dz,
+            leaked_volume=view.leaked)
         return FractureSnapshot(
-            time=self.t, frame=frame, width=np.where(act, g["w"][rs, cs], 0.0),
-            pressure=np.where(act, g["p"][rs, cs], 0.0),
+            time=time, frame=frame, width=width, pressure=np.where(act, g["p"][rs, cs], 0.0),
             leakoff_rate=np.where(act, g["leak_rate"][rs, cs], 0.0),
             opening_time=np.where(act, g["opened"][rs, cs], np.nan),
-            extras={f"front_{k}": np.array(v) for k, v in self.front().items()})
+            extras={k: np.array(v) for k, v in scalars.items()})
 
-    def front(self) -> dict:
+    def geometry(self, view: _View) -> dict:
+        """Area, equal-area radius, length and height of the footprint, tip cells by their filled fraction
+        (geometry.py)."""
+        g = view.grid
+        fraction = filled_fraction(self.num.front_tracking, g["active"], g["fill"], g["opened"], g["filled"], view.t)
+        return footprint(fraction, g.dx, g.dz)
+
+    def front(self, view: _View) -> dict:
         """Sub-grid front: distances from the injection point to the front and its extents up (-z), down
         (+z), left (-x), right (+x). With cells: r + s at the edge cells (s from the inverted tip asymptote,
         capped at one cell); with the sub-grid front: the points x + a n of the tip cells (tip_cells), or as
         with cells where there are none (right after a coarsening)."""
-        g = self.grid
+        g, dx, dz = view.grid, view.grid.dx, view.grid.dz
         xo, zo = g.offsets()
         tips = np.zeros(g.shape, bool)
         if self.num.front_tracking == "subgrid":
             channel = g["active"] & (g["fill"] >= 1.0)
-            s_rib, _ = ribbon_distances(self.tip, channel, g["w"], g["p"], self.kprime_box, self.cprime_box,
-                                        g["reached"], self.t, self.dx, self.dz)
-            _, nx, nz, _ = level_set(s_rib, channel, self.dx, self.dz)
+            s_rib, _ = ribbon_distances(self.tip, channel, g["w"], g["p"], view.kprime_box, view.cprime_box,
+                                        g["reached"], view.t, dx, dz)
+            _, nx, nz, _ = level_set(s_rib, channel, dx, dz)
             tips = g["active"] & ~channel & np.isfinite(g["advance"]) & np.isfinite(nx)
         if tips.any():   # none right after a coarsening: every cell is then a channel cell
             px, pz = (xo + g["advance"] * nx)[tips], (zo + g["advance"] * nz)[tips]
             radii = np.hypot(px, pz)
             ext = dict(right=px.max(), left=-px.min(), down=pz.max(), up=-pz.min())
         else:
-            dist = front_distances(self.tip, g["active"], g["w"], g["p"], self.kprime_box, self.cprime_box,
-                                   g["reached"], self.t, self.dx, self.dz)
+            dist = front_distances(self.tip, g["active"], g["w"], g["p"], view.kprime_box, view.cprime_box,
+                                   g["reached"], view.t, dx, dz)
             best = np.zeros(xo.shape)
             ext = {}
             for name, (dk, di), s in zip(("right", "left", "down", "up"), DIRECTIONS, dist):
-                s = np.minimum(s, self.dz if dk else self.dx)
+                s = np.minimum(s, dz if dk else dx)
                 coord = (zo * dk if dk else xo * di) + s
                 ext[name] = np.nanmax(coord) if np.isfinite(coord).any() else 0.0
                 best = np.fmax(best, s)
             edge = edge_cells(g["active"])
             radii = np.hypot(xo, zo)[edge] + best[edge]
         return dict(radius=float(radii.mean()), radius_min=float(radii.min()), radius_max=float(radii.max()),
-                    area_radius=math.sqrt(g["active"].sum() * self.area / math.pi),
                     **{k: max(float(v), 0.0) for k, v in ext.items()})
 
     # -- checkpoints ------------------------------------------------------------------------------
@@ -598,21 +643,19 @@ class _Engine:
         self._rebuild()
 
 
-def _targets(scene, t0: float) -> tuple[list[float], set[float]]:
-    """(times steps must land on, output times): schedule breakpoints, every ``output.every`` and the end.
-    Times within 1e-9 (relative) of each other are one target, so a breakpoint that coincides with an output
-    time up to round-off (e.g. 3 x 0.1 s and 0.3 s) gives one step target and the output keeps its snapshot,
-    stamped with the output time."""
+def _times(scene, t0: float) -> tuple[list[float], list[float]]:
+    """(times steps must land on, output times), both sorted: the schedule's breakpoints and the end (physics),
+    and every ``output.every`` and the end, after t0."""
     end = scene.run.end_time
     every = scene.output.every
     outputs = {every * k for k in range(1, int(math.floor(end / every + 1e-9)) + 1)} | {end}
-    outputs = {t for t in outputs if t0 < t <= end}
-    breaks = [b for b in scene.injection.schedule.breakpoints() if t0 < b < end]
-    times = sorted(outputs)
-    for b in breaks:
-        if all(abs(b - t) > 1e-9 * t for t in times):
-            times.append(b)
-    return sorted(times), outputs
+    breaks = {b for b in scene.injection.schedule.breakpoints() if t0 < b < end}
+    return sorted(breaks | {end}), sorted(t for t in outputs if t0 < t <= end)
+
+
+def _landed(output: float, t: float) -> bool:
+    """Whether a step ending at t lands on the output time (within 1e-9 relative: 3 x 0.1 s is 0.3 s)."""
+    return abs(output - t) <= 1e-9 * t
 
 
 def simulate(scene, sink, progress: Callable[[float], None] | None = None, checkpoint=None,
@@ -621,26 +664,32 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
 
     Calls ``sink.fracture_balance(BalanceRecord)`` after every accepted step and
     ``sink.fracture_snapshot(FractureSnapshot)`` at every ``output.every`` and at the end; ``progress(t)``
-    after each step. With ``mesh.max_cells_across`` set, the grid is merged 3x3 each time the footprint
-    spans more cells than that along x or z (snapshots then carry the coarser frame). Returns a summary:
-    time, steps, newton_iterations, retries, rejected (steps redone for a too-long front advance),
-    coarsenings, dx, dz (final cell sizes), cells, the sub-grid
-    front (radius, radius_min, radius_max, area_radius, up, down, left, right), w_inlet, p_inlet, the final
-    balance (injected, stored, leaked) and max_balance_error (relative).
+    after each step. Steps land on the schedule's breakpoints and the end time, never on output times: a
+    snapshot at a time inside a step is interpolated between the step's two ends (interpolate.py), one at
+    a time a step lands on (within 1e-9 relative, the end time always) is that step's state, so the steps
+    and the solution do not depend on ``output.every``. With ``mesh.max_cells_across`` set, the grid is
+    merged 3x3 each time the footprint spans more cells than that along x or z (snapshots then carry the
+    coarser frame). Returns a summary: time, steps, newton_iterations, retries, rejected (steps redone for a
+    too-long front advance), coarsenings, dx, dz (final cell sizes), cells, the sub-grid front (radius,
+    radius_min, radius_max, up, down, left, right), the footprint (area, area_radius, length, height;
+    geometry.py), w_inlet, p_inlet, the final balance (injected, stored, leaked) and max_balance_error
+    (relative).
 
-    Checkpoints (hfgpu.io.checkpoint): after the first step that ends at or past each interval,
-    ``checkpoint.save(t, state)`` gets {"engine": _Engine.state(), "dt": next step, "target": index of the
-    step target}; ``resume`` (such a state) continues from it, with the same steps as an uninterrupted run.
+    Checkpoints (hfgpu.io.checkpoint): after the first step that ends at or past each interval (and after
+    that step's snapshots), ``checkpoint.save(t, state)`` gets {"engine": _Engine.state(), "dt": next step,
+    "target": index of the step target}; ``resume`` (such a state) continues from it, with the same steps as
+    an uninterrupted run and the snapshots after t.
     """
     _check_scene(scene)
     numerics = scene.fracture if scene.fracture is not None else FractureNumerics()
     eng = _Engine(scene, numerics)
-    targets, outputs = _targets(scene, eng.t0)
+    targets, outputs = _times(scene, eng.t0)
     dt = numerics.time_step_relaxation * min(eng.dx, eng.dz) / eng.v_front
     first = 0
     if resume is not None:
         eng.restore(resume["engine"])
         dt, first = resume["dt"], int(resume["target"])
+    k = sum(1 for t in outputs if t < eng.t or _landed(t, eng.t)) if resume is not None else 0   # next output
     for index in range(first, len(targets)):
         target = targets[index]
         while eng.t < target * (1 - 1e-12):
@@ -652,7 +701,7 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
                 raise SimulationError(f"the time step fell to {step:.3g} s (below {MIN_STEP_FRACTION:g} of the "
                                       "time): the front keeps moving more than max_front_advance cells however "
                                       "short the step; raise [fracture] max_front_advance", time=eng.t)
-            taken = eng.step(step)
+            taken = eng.step(step, keep_ends=k < len(outputs) and outputs[k] < eng.t + step)
             if abs(eng.t - target) < 1e-9 * target:
                 eng.t = target
             record = eng.balance()
@@ -661,11 +710,13 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
             sink.fracture_balance(record)
             if progress is not None:
                 progress(eng.t)
+            while k < len(outputs) and (outputs[k] < eng.t or _landed(outputs[k], eng.t)):
+                view = eng.now() if _landed(outputs[k], eng.t) else eng.between(outputs[k])
+                sink.fracture_snapshot(eng.snapshot(view, outputs[k]))
+                k += 1
             dt = eng.next_dt(dt if taken == step else taken)
             if checkpoint is not None and checkpoint.due(eng.t):
                 checkpoint.save(eng.t, {"engine": eng.state(), "dt": dt, "target": index})
-        if target in outputs:
-            sink.fracture_snapshot(eng.snapshot())
     g = eng.grid
     inj = (eng.rows[eng.inj], eng.cols[eng.inj])
     final = eng.balance()
@@ -673,4 +724,5 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
                 retries=eng.retries, rejected=eng.rejected, coarsenings=eng.coarsenings, dx=eng.dx, dz=eng.dz,
                 cells=int(g["active"].sum()), w_inlet=float(g["w"][inj]),
                 p_inlet=float(g["p"][inj]), injected=final.injected, stored=final.stored,
-                leaked=final.leaked, max_balance_error=eng.max_balance_error, **eng.front())
+                leaked=final.leaked, max_balance_error=eng.max_balance_error, **eng.front(eng.now()),
+                **eng.geometry(eng.now()))

@@ -60,6 +60,10 @@ UNITS = {
     "state": "1", "class_id": "1", "volume_fraction": "1", "fluid_u": "m/s", "fluid_v": "m/s",
     "bridging_risk": "1",
     "scene": "",
+    # the fracture engine's scalar snapshot extras (docs/results-format.md)
+    **{f"front_{k}": "m" for k in ("radius", "radius_min", "radius_max", "up", "down", "left", "right")},
+    "area": "m^2", "area_radius": "m", "length": "m", "height": "m",
+    "injected_volume": "m^3", "stored_volume": "m^3", "leaked_volume": "m^3",
 }
 UNKNOWN_UNITS = "unspecified"
 

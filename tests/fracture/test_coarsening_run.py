@@ -31,8 +31,9 @@ def test_volume_balance_holds_across_coarsening_and_footprint_stays_capped():
         open_ = np.isfinite(snap.opening_time)
         rows, cols = np.nonzero(open_)
         assert max(np.ptp(rows), np.ptp(cols)) + 1 <= cap + 2   # one front advance past the cap at most
-        assert snap.width[open_].sum() * snap.frame.dx * snap.frame.dz == pytest.approx(
-            next(b.stored for b in sink.fracture_balances if b.time == snap.time), rel=1e-12)
+        stored = snap.width[open_].sum() * snap.frame.dx * snap.frame.dz   # snapshots between steps too
+        injected, leaked = float(snap.extras["injected_volume"]), float(snap.extras["leaked_volume"])
+        assert abs(injected - stored - leaked) <= 1e-9 * injected
     # the same fracture run on a fine uncapped grid (1 m cells) ends at a radius within 10 %
     fine = simulate(scene(end_time="100 s", cell="1 m"), MemorySink())
     assert out["radius"] == pytest.approx(fine["radius"], rel=0.1)

@@ -2,7 +2,9 @@
 vertex closed forms (Savitski & Detournay 2002; REFERENCE.md 1.1, 1.3), via hfgpu.reference.radial.
 
 Default runs are coarse (about 20-25 cells across the final diameter); tolerances reflect that. The
-refinement series and the 2 % (radius) / 5 % (inlet width) goals are marked slow.
+refinement series and the 2 % (radius) / 5 % (inlet width) goals are marked slow. R is the front's mean
+radius (the summary's ``radius``); R_area = sqrt(area / pi), the radius of the footprint's area with tip cells
+counted by their filled fraction (geometry.py), is what the sub-grid front's checks use (test_subgrid_front.py).
 """
 
 import dataclasses
@@ -32,13 +34,16 @@ def run_case(name: str, cell: float | None = None, **numerics):
     q, t = sc.injection.schedule.stages[0].rate, sc.run.end_time
     ref = dontsov_radial(e_prime, k_prime, mu_prime, c_prime, q, t)
     errors = dict(R=out["radius"] / ref.R[-1] - 1, w0=out["w_inlet"] / ref.w0[-1] - 1,
-                  R_min=out["radius_min"] / ref.R[-1] - 1, R_max=out["radius_max"] / ref.R[-1] - 1)
+                  R_min=out["radius_min"] / ref.R[-1] - 1, R_max=out["radius_max"] / ref.R[-1] - 1,
+                  R_area=out["area_radius"] / ref.R[-1] - 1)
     return out, sink, errors, (e_prime, mu_prime, k_prime, q, t)
 
 
 def test_case_I_storage_viscosity_coarse():
     out, sink, err, (e, mu, k, q, t) = run_case("I")            # 5 m cells, ~22 across
-    assert abs(err["R"]) < 0.06 and abs(err["w0"]) < 0.04, err
+    # measured: front's mean radius +0.22 %, from the area -3.55 % (the cells front counts its last rings of
+    # cells by the time the front takes to cross them, geometry.py), w0 +0.67 %
+    assert abs(err["R"]) < 0.06 and abs(err["R_area"]) < 0.06 and abs(err["w0"]) < 0.04, err
     vertex = m_vertex(e, mu, q, t)                                 # the case sits at the M vertex
     assert out["radius"] == pytest.approx(float(vertex.R), rel=0.06)
     assert out["max_balance_error"] < 1e-3
