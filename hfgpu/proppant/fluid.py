@@ -9,7 +9,8 @@ with the momentum predictor of Eq. 26 (:mod:`hfgpu.proppant.momentum`, NumPy or 
 backend), by pressure correction: predictor with the guessed pressure p* -> pressure-correction equation
 (5-point, symmetric positive definite, assembled in scipy.sparse; its coefficients do not depend on p, so
 one matrix per step, solved by conjugate gradients preconditioned with the LU factors of an earlier step
-and refactorised (SuperLU) when that takes too many iterations) -> p = p* + p', u = u* + d (p'_W - p'_E)
+and refactorised (SuperLU) when that takes too many iterations; on CUDA, Jacobi-preconditioned CG on the GPU,
+:mod:`hfgpu.proppant.correction_warp`) -> p = p* + p', u = u* + d (p'_W - p'_E)
 -> repeat until max|p'| <= tolerance x max(max|p|, pressure_floor) (the paper's 1e-5 criterion, made
 relative).
 Because the predictor couples a face only to its own pressure difference, the correction is exact and
@@ -35,6 +36,7 @@ from scipy.sparse.linalg import splu
 from ..errors import SceneError, SimulationError
 from . import momentum as numpy_momentum
 from .closures import fluid_fraction, slurry_viscosity
+from .correction_warp import WarpCorrectionSolver, cuda_available
 from .grid import StaggeredGrid, face_mean
 from .params import MppicParams
 
@@ -141,15 +143,18 @@ class FluidSolver:
 
     rho_f [kg/m^3], mu_0 [Pa s]: fluid density and clean-fluid viscosity; ``backend``: any object with
     ``momentum_predictor`` of the signature of :func:`hfgpu.proppant.momentum.momentum_predictor` (the
-    backends of :mod:`hfgpu.proppant.backend`); default the NumPy reference. ``params``
+    engines of :mod:`hfgpu.proppant.engine`); default the NumPy reference. ``params``
     (:class:`hfgpu.proppant.params.MppicParams`): when given, the slurry viscosity mu_f(theta_p) of Eq. 10
     (:func:`hfgpu.proppant.closures.slurry_viscosity`) is used, else mu_0 everywhere. ``wall_friction``: the
     predictor's wall-friction law, "laminar" (Eq. 9) or "dean" (MppicParams.wall_friction).
+    ``linear_solver`` ("auto", "scipy", "warp") and ``arch`` (the Taichi architecture in use,
+    :func:`hfgpu.kernels.runtime.init`'s answer): the pressure-correction solver, see :func:`correction_solver`;
+    the defaults keep SciPy on the CPU.
     """
 
     def __init__(self, grid: StaggeredGrid, rho_f: float, mu_0: float,
                  numerics: FluidNumerics = FluidNumerics(), backend=None, params: MppicParams | None = None,
-                 wall_friction: str = "laminar"):
+                 wall_friction: str = "laminar", linear_solver: str = "auto", arch: str = "cpu"):
         for name, value in (("fluid.density", rho_f), ("fluid.viscosity", mu_0)):
             if not (np.isfinite(value) and value > 0.0):
                 raise SceneError(name, value, "must be finite and > 0")
@@ -158,7 +163,7 @@ class FluidSolver:
         self.numerics = numerics
         self.params = params
         self.wall_friction = wall_friction
-        self._linear = _CorrectionSolver(numerics.linear_rtol, numerics.reuse_iterations)
+        self._linear = correction_solver(linear_solver, numerics.linear_rtol, numerics.reuse_iterations, arch)
         self.backend = numpy_momentum if backend is None else backend
         self.set_grid(grid)
 
@@ -168,9 +173,9 @@ class FluidSolver:
         return self._linear.factorisations
 
     @property
-    def linear(self) -> "_CorrectionSolver":
-        """The pressure-correction solver, whose LU factors carry over between steps (its state() and restore()
-        serve checkpoints)."""
+    def linear(self) -> _CorrectionSolver | WarpCorrectionSolver:
+        """The pressure-correction solver, whose LU factors carry over between steps (SciPy; the Warp solver
+        carries nothing over); its state() and restore() serve checkpoints."""
         return self._linear
 
     # -- grid -------------------------------------------------------------------------------------
@@ -489,12 +494,36 @@ class _CorrectionSolver:
         return state
 
     def restore(self, state: dict) -> None:
-        """Back to a :meth:`state`: the same key and, refactorised from the same matrix, the same LU factors."""
-        self.key = np.asarray(state["key"], dtype=np.uint8).tobytes()
+        """Back to a :meth:`state`: the same key and, refactorised from the same matrix, the same LU factors. The
+        empty state of the Warp solver (a GPU run resumed on a CPU) restores no factors."""
+        self.key = np.asarray(state.get("key", ()), dtype=np.uint8).tobytes()
         self.lu = self.factorised = None
         if "data" in state:
             self._factorise(sp.csc_matrix((state["data"], state["indices"], state["indptr"]),
                                           shape=tuple(int(n) for n in state["shape"])))
+
+
+LINEAR_SOLVERS = ("auto", "scipy", "warp")
+
+
+def correction_solver(kind: str, rtol: float, reuse_iterations: int,
+                      arch: str = "cpu") -> _CorrectionSolver | WarpCorrectionSolver:
+    """The pressure-correction solver of ``kind`` (one of LINEAR_SOLVERS) for the Taichi architecture ``arch``
+    that runs ("cpu" or "cuda", :func:`hfgpu.kernels.runtime.init`'s answer):
+    "scipy": :class:`_CorrectionSolver` (SuperLU, CG reusing an earlier step's factors; host memory);
+    "warp": :class:`hfgpu.proppant.correction_warp.WarpCorrectionSolver` (Jacobi CG) on Warp's device of the
+    same name as ``arch``; "auto": "warp" when ``arch`` is "cuda" and warp is installed and sees a CUDA device,
+    else "scipy" (the CPU default).
+    ValueError for another ``kind``; ImportError naming the extra to install when "warp" is asked without warp.
+    """
+    if kind not in LINEAR_SOLVERS:
+        raise ValueError(f"linear_solver {kind!r}: allowed {', '.join(map(repr, LINEAR_SOLVERS))}")
+    on_cuda = arch == "cuda"
+    if kind == "auto":
+        kind = "warp" if on_cuda and cuda_available() else "scipy"
+    if kind == "scipy":
+        return _CorrectionSolver(rtol, reuse_iterations)
+    return WarpCorrectionSolver(rtol, "cuda" if on_cuda else "cpu")
 
 
 def _preconditioned_cg(matrix, rhs, precondition, limit, max_iterations):
