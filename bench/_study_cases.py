@@ -209,7 +209,7 @@ def _davis(scene: Scene) -> tuple[int, int, int, dict]:
 
     def on_step(info):
         frame, width = sim.grid.frame, sim.grid.width
-        profiles = [row_profile(class_volume_fraction(sim.backend, sim.parcels, frame, width, c), width)
+        profiles = [row_profile(class_volume_fraction(sim.parcels, frame, width, c), width)
                     for c in (1, 0)]
         record.append((sim.time, interface_depth(profiles[0], frame, 0.5 * theory.phi_light_only),
                        interface_depth(profiles[1], frame, 0.5 * phi_heavy)))

@@ -1,15 +1,16 @@
-"""Parcel updates per second of the MP-PIC particle operations, Taichi vs the NumPy reference.
+"""The MP-PIC particle engine: time per fluid step against the time its kernels take, and parcel-updates/s.
 
-    python bench/bench_kernels.py [--sizes 1e4 1e5 1e6] [--arch cpu] [--repeats 5] [--threads 2] [--profile]
+    python bench/bench_kernels.py [--sizes 1e4 1e5 1e6] [--arch cpu] [--threads 2] [--substeps 4]
+                                  [--steps 5] [--numpy-up-to 1e5]
 
 Grid 200 x 100 cells (nx x nz), a random open/closed width field, random parcels in open cells, random fluid.
-Columns: M parcel-updates/s (best of ``repeats`` timed calls after one warm-up call: the machine may be shared)
-for scatter of parcels in random order, and, on parcels sorted by cell (Parcels.sort_by_cell, as a simulator
-does every few steps), scatter, gather, push, gather + push, exchange, the whole particle step (scatter, grid
-fields, gather, push, exchange), and the re-sort of nearly sorted parcels; speed-up of Taichi over NumPy.
-Prints a table per size; asserts nothing. ``--profile``: before each table, the Taichi kernel profiler's table
-(min / avg / max time per kernel: kernel time only, without Python, launch and ndarray overhead).
-``--threads``: Taichi CPU threads (default all cores).
+A fluid step is what the run loop does with the engine: begin_step (sort by cell, compaction, fluid in),
+``substeps`` sub-steps, moments (theta_p out), commit. Columns per size (best of ``steps`` fluid steps after
+one warm-up step; the machine may be shared): wall ms per fluid step, the kernels' own ms in it (Taichi's
+kernel profiler: device time without Python, launch and argument overhead), their ratio (the overhead
+target: <= 2 at 1e4-1e5 parcels), the launches per fluid step, the whole sub-step in M parcel-updates/s from
+its kernel time and from wall time, and the NumPy engine's wall ms per fluid step (the oracle) up to
+``--numpy-up-to`` parcels. Asserts nothing. bench/bench_gpu.py runs the same on CUDA.
 """
 
 from __future__ import annotations
@@ -20,17 +21,18 @@ import time
 import numpy as np
 
 from hfgpu.kernels.runtime import init, ti
-from hfgpu.proppant.backend import get_backend, grid_fields
+from hfgpu.proppant.engine import make_engine
+from hfgpu.proppant.grid import StaggeredGrid
 from hfgpu.proppant.params import MppicParams
 from hfgpu.proppant.parcels import Parcels
 from hfgpu.records import GridFrame
 
 NX, NZ = 200, 100
-RHO_F, MU, G, DT = 1000.0, 1e-3, 9.81, 1e-4
+RHO_F, MU, G, DT = 1000.0, 1e-3, 9.81, 4e-4
 
 
 def make_case(n: int, seed: int = 0):
-    """Grid, fluid fields and ``n`` parcels (uniform over the open cells)."""
+    """Grid, fluid fields (u, v, p) and ``n`` parcels (uniform over the open cells)."""
     rng = np.random.default_rng(seed)
     frame = GridFrame(dx=0.01, dz=0.01, x0=0.005, z0=0.005)
     width = rng.uniform(2e-3, 5e-3, (NZ, NX))
@@ -42,85 +44,80 @@ def make_case(n: int, seed: int = 0):
     parcels = Parcels.create(x, z, radius=r, density=2650.0, particles=solid / (4 / 3 * np.pi * r ** 3),
                              u=rng.normal(0, 0.01, n), v=rng.normal(0, 0.01, n))
     fluid = (rng.normal(0, 0.05, (NZ, NX + 1)), rng.normal(0, 0.05, (NZ + 1, NX)), rng.normal(0, 10, (NZ, NX)))
-    return frame, width, parcels, fluid
+    return StaggeredGrid.from_width(frame, width), parcels, fluid
 
 
-def timed(fn, repeats: int) -> float:
-    """Best wall time of fn() over ``repeats`` calls after one warm-up call."""
-    fn()
-    times = []
-    for _ in range(repeats):
+def fluid_step(engine, fluid, substeps: int, profile: bool = False) -> tuple[float, float]:
+    """One fluid step of the run loop's particle side; returns (kernel seconds of the whole step, of its
+    sub-steps) from Taichi's profiler when ``profile``."""
+    clock = Profiler(profile)
+    engine.begin_step(*fluid)
+    before = clock.read()
+    engine.substeps(DT, substeps, 0.0)
+    during = clock.read()
+    engine.moments()
+    engine.commit()
+    return before + during + clock.read(), during
+
+
+class Profiler:
+    """Kernel seconds since the last read (Taichi's kernel profiler; 0 when off)."""
+
+    def __init__(self, on: bool):
+        self.on = on
+        self.read()
+
+    def read(self) -> float:
+        if not self.on:
+            return 0.0
+        ti.sync()
+        total = ti.profiler.get_kernel_profiler_total_time()
+        ti.profiler.clear_kernel_profiler_info()
+        return total
+
+
+def measure(name: str, n: int, substeps: int, steps: int, profile: bool) -> dict[str, float]:
+    """Wall and kernel seconds per fluid step, launches per fluid step and the sub-steps' kernel seconds of
+    engine ``name`` at ``n`` parcels (the fluid step of least wall time)."""
+    grid, parcels, fluid = make_case(n)
+    engine = make_engine(name, grid, MppicParams(), RHO_F, MU, G, np.zeros(grid.shape, dtype=bool))
+    engine.set_parcels(parcels)
+    fluid_step(engine, fluid, substeps)
+    rows = []
+    for _ in range(steps):
+        launches = getattr(engine, "launches", 0)
         t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
-
-
-def measure(backend, n: int, repeats: int) -> dict[str, float]:
-    """Seconds per call of each operation for ``n`` parcels."""
-    params = MppicParams()
-    frame, width, parcels, (u, v, p) = make_case(n)
-    random_order = timed(lambda: backend.scatter(parcels, frame, width), repeats)
-    parcels.sort_by_cell(frame, width.shape)
-    moments = backend.scatter(parcels, frame, width)
-    fields = grid_fields(frame, width, u, v, p, moments, params)
-    work = parcels.copy()
-    seen = backend.gather(work, frame, fields)
-    drag = backend.push(work.copy(), seen, frame, fields, DT, params, RHO_F, MU, G)
-
-    def gather_push():
-        seen = backend.gather(work, frame, fields)
-        backend.push(work, seen, frame, fields, DT, params, RHO_F, MU, G)
-
-    def step():
-        m = backend.scatter(work, frame, width)
-        f = grid_fields(frame, width, u, v, p, m, params)
-        seen = backend.gather(work, frame, f)
-        drag = backend.push(work, seen, frame, f, DT, params, RHO_F, MU, G)
-        backend.exchange(work, seen, drag, frame, width)
-
-    return {"scatter (random order)": random_order,
-            "scatter": timed(lambda: backend.scatter(work, frame, width), repeats),
-            "gather": timed(lambda: backend.gather(work, frame, fields), repeats),
-            "push": timed(lambda: backend.push(work, seen, frame, fields, DT, params, RHO_F, MU, G), repeats),
-            "gather+push": timed(gather_push, repeats),
-            "exchange": timed(lambda: backend.exchange(work, seen, drag, frame, width), repeats),
-            "step": timed(step, repeats),
-            "re-sort": timed(lambda: work.sort_by_cell(frame, width.shape), repeats)}
+        kernels, sub = fluid_step(engine, fluid, substeps, profile)
+        rows.append((time.perf_counter() - t, kernels, sub, getattr(engine, "launches", 0) - launches))
+    wall, kernels, sub, launches = min(rows)
+    return dict(wall=wall, kernels=kernels, substep=sub / substeps, launches=launches)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sizes", type=float, nargs="+", default=[1e4, 1e5, 1e6])
-    ap.add_argument("--arch", default=None, help="Taichi arch (default HFGPU_ARCH or cpu)")
-    ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--skip-numpy-above", type=float, default=1e7)
-    ap.add_argument("--threads", type=int, default=None)
-    ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--arch", default=None, help="Taichi arch: cpu or cuda (default HFGPU_ARCH or cpu)")
+    ap.add_argument("--threads", type=int, default=None, help="Taichi CPU threads (default: all cores)")
+    ap.add_argument("--substeps", type=int, default=4)
+    ap.add_argument("--steps", type=int, default=5)
+    ap.add_argument("--numpy-up-to", type=float, default=1e5)
     args = ap.parse_args()
-    init(args.arch, kernel_profiler=args.profile, cpu_threads=args.threads)
-    ti_backend = get_backend("taichi", arch=args.arch)
-    np_backend = get_backend("numpy")
-    print(f"grid {NX} x {NZ}, Taichi arch {ti_backend.arch}; M parcel-updates/s (best of {args.repeats})")
-    head = f"{'parcels':>9} | {'op':<22} | {'taichi':>9} | {'numpy':>9} | {'speed-up':>8}"
+    arch = init(args.arch, kernel_profiler=True, cpu_threads=args.threads)
+    threads = ti.lang.impl.current_cfg().cpu_max_num_threads if arch == "cpu" else "-"
+    print(f"grid {NX} x {NZ}, {args.substeps} sub-steps per fluid step, Taichi on {arch} ({threads} threads); "
+          f"best of {args.steps} fluid steps")
+    head = (f"{'parcels':>9} | {'wall ms':>9} | {'kernel ms':>9} | {'wall/kernel':>11} | {'launches':>8} | "
+            f"{'sub-step M/s (kernel)':>21} | {'(wall)':>7} | {'numpy ms':>9}")
+    print(head)
+    print("-" * len(head))
     for size in args.sizes:
         n = int(size)
-        if args.profile:
-            ti.profiler.clear_kernel_profiler_info()
-        t_ti = measure(ti_backend, n, args.repeats)
-        if args.profile:
-            print(f"Taichi kernel profiler, {n} parcels (min: the fastest call, kernel time only)")
-            ti.profiler.print_kernel_profiler_info()
-        t_np = measure(np_backend, n, max(1, args.repeats // 2)) if n <= args.skip_numpy_above else None
-        print(head)
-        print("-" * len(head))
-        for op, seconds in t_ti.items():
-            rate = n / seconds / 1e6
-            if t_np is None:
-                print(f"{n:>9} | {op:<22} | {rate:9.2f} | {'-':>9} | {'-':>8}")
-            else:
-                np_rate = n / t_np[op] / 1e6
-                print(f"{n:>9} | {op:<22} | {rate:9.2f} | {np_rate:9.2f} | {rate / np_rate:8.1f}")
+        t = measure("taichi", n, args.substeps, args.steps, profile=True)
+        numpy_ms = (f"{1e3 * measure('numpy', n, args.substeps, 2, profile=False)['wall']:9.1f}"
+                    if n <= args.numpy_up_to else f"{'-':>9}")
+        print(f"{n:>9} | {1e3 * t['wall']:9.2f} | {1e3 * t['kernels']:9.2f} | {t['wall'] / t['kernels']:11.2f} | "
+              f"{t['launches']:8.0f} | {n / t['substep'] / 1e6:21.1f} | "
+              f"{n * args.substeps / t['wall'] / 1e6:7.1f} | {numpy_ms}")
 
 
 if __name__ == "__main__":

@@ -43,9 +43,9 @@ def main() -> None:
     history = []
 
     def record(info):
-        frame, width = sim.grid.frame, sim.grid.width
-        th = class_volume_fraction(sim.backend, sim.parcels, frame, width, 0)
-        tl = class_volume_fraction(sim.backend, sim.parcels, frame, width, 1)
+        frame, width, parcels = sim.grid.frame, sim.grid.width, sim.parcels
+        th = class_volume_fraction(parcels, frame, width, 0)
+        tl = class_volume_fraction(parcels, frame, width, 1)
         history.append((sim.time,
                         height - interface_depth(row_profile(tl, width), frame, 0.5 * theory.phi_light_only),
                         height - interface_depth(row_profile(th, width), frame, 0.5 * heavy.initial_volume_fraction)))

@@ -85,6 +85,14 @@ def main() -> None:
     fig.savefig(out / "slot_bank.png", dpi=150)
     for s, b in zip(sink.proppant_snapshots, banks):
         print(f"t = {s.time:5.1f} s  bank length {b.normalised_length:.3f}  area {b.normalised_area:.3f}")
+    fractions = (0.3, 0.4, 0.5, 0.6, 0.7)
+    print("bank length against the bank threshold (theta_p >= fraction x theta_cp; the validation uses 0.5):")
+    print("    t [s] | " + " | ".join(f"{f:5.1f}" for f in fractions))
+    for s in sink.proppant_snapshots:
+        if any(abs(s.time - t) < 1e-6 for t in (10.0, 12.5, 15.0, 20.0, 30.0)):
+            lengths = [bank(s.grid["volume_fraction"], s.grid["width"], s.frame, f * sim.params.theta_cp)
+                       for f in fractions]
+            print(f"    {s.time:5.1f} | " + " | ".join(f"{b.normalised_length:5.3f}" for b in lengths))
     print(f"{summary['steps']} steps, {summary['parcels']} parcels, outflow {summary['outflow']:.3e} m^3; "
           f"figures in {out}/")
 

@@ -303,7 +303,7 @@ def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None =
     sub = proppant_scene(scene, frame, shape, width0, start)
     sim = ProppantSimulation(sub, width_field=lambda t: history.fields_at(t + start, frame, shape)[:2])
     sim.solver.step = timings.wrap("fluid", sim.solver.step)
-    sim._particle_subloop = timings.wrap("parcels", sim._particle_subloop)
+    sim.engine.substeps = timings.wrap("parcels", sim.engine.substeps)
     shift = _ProppantShift(sink, start, scene.proppant.params.bridging_factor, timings)
     if phase == "proppant":
         shift.restore(resume["screen_out"])

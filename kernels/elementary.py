@@ -35,7 +35,7 @@ ATANH_SERIES = tuple(1.0 / (2 * j + 3) for j in range(10))  # (atanh(s) / s - 1)
 
 
 @ti.func
-def estrin(x: ti.f64, c: ti.template()) -> ti.f64:
+def estrin(x, c: ti.template()):
     """sum_j c[j] x^j (10 to 16 coefficients) by Estrin's scheme (Knuth, TAOCP vol. 2, 4.6.4): pairs
     c[j] + c[j+1] x combined with x^2, x^4, x^8; a short dependency chain, so that the independent parcels of a
     push task overlap."""
@@ -54,8 +54,9 @@ def estrin(x: ti.f64, c: ti.template()) -> ti.f64:
 
 
 @ti.func
-def exp(x: ti.f64) -> ti.f64:
-    """e^x (relative error < 2 x 2^-52) for x in [-708, 709] (arguments clamped there); see the module docstring."""
+def exp(x):
+    """e^x (relative error < 2 x 2^-52) for x in [-708, 709] (arguments clamped there), elementwise for a
+    vector x (the push's LANES parcels: one body, vectorised by LLVM); see the module docstring."""
     xc = ti.min(ti.max(x, EXP_MIN), EXP_MAX)
     t = xc * INV_LN2 + ROUNDER  # k = round(x / ln 2) in the low bits of t (no float-to-int conversion)
     k = t - ROUNDER
@@ -66,9 +67,9 @@ def exp(x: ti.f64) -> ti.f64:
 
 
 @ti.func
-def log(x: ti.f64) -> ti.f64:
-    """Natural logarithm (relative error < 2 x 2^-52) of finite x > 0, subnormals included; see the module
-    docstring."""
+def log(x):
+    """Natural logarithm (relative error < 2 x 2^-52) of finite x > 0, subnormals included, elementwise for a
+    vector x; see the module docstring."""
     small = x < 2.2250738585072014e-308
     xs = ti.select(small, x * TWO54, x)
     bits = ti.bit_cast(xs, ti.i64)

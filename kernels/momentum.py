@@ -51,7 +51,7 @@ def predict_x(u0: F64_2D, v0: F64_2D, p: F64_2D, width0: F64_2D, theta_f0: F64_2
     """u* and d on the x-faces (Eq. 49 with Eq. 62-65, friction Eq. 9 and the u_P flux coefficients
     point-implicit; dean = 1: Eq. 9 times Dean's f_t); walls and closed faces get 0."""
     nz, nx = width.shape[0], width.shape[1]
-    for k, i in ti.ndrange(nz, nx + 1):
+    for k, i in ti.ndrange((0, nz), (0, nx + 1)):
         us, dd = 0.0, 0.0
         inside = 1 <= i and i <= nx - 1
         is_open = False

@@ -9,14 +9,14 @@ import numpy as np
 
 from ..records import GridFrame
 from .parcels import Parcels
+from .particle_ops_numpy import finish_moments, moment_sums
 
 
-def class_volume_fraction(backend, parcels: Parcels, frame: GridFrame, width: np.ndarray,
-                          class_id: int) -> np.ndarray:
-    """theta_p (nz, nx) of the parcels of one class (Eq. 38 on that class alone)."""
+def class_volume_fraction(parcels: Parcels, frame: GridFrame, width: np.ndarray, class_id: int) -> np.ndarray:
+    """theta_p (nz, nx) of the parcels of one class (Eq. 38 on that class alone, NumPy scatter)."""
     subset = parcels.copy()
     subset.drop(subset.class_id != class_id)
-    return backend.scatter(subset, frame, width).volume_fraction
+    return finish_moments(moment_sums(subset, frame, width), frame, width).volume_fraction
 
 
 def row_profile(volume_fraction: np.ndarray, width: np.ndarray) -> np.ndarray:

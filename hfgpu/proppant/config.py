@@ -39,6 +39,7 @@ PORT_KINDS = ("point", "segment", "annulus")
 #: Directions an inlet's slurry may enter along as a jet (``jet``; "none": a source without momentum).
 JET_DIRECTIONS = ("none", "+x", "-x", "+z", "-z")
 BACKENDS = ("taichi", "numpy")
+ARCHES = ("cpu", "cuda")  # Taichi architectures with float64 kernels
 
 
 @dataclass(frozen=True)
@@ -96,8 +97,8 @@ class ProppantClass:
 class MppicNumerics:
     """Numerical knobs of the MP-PIC run loop.
 
-    backend/arch: particle and momentum kernels ("taichi" default, "numpy" reference); arch as
-    hfgpu.kernels.runtime (None: HFGPU_ARCH or cpu).
+    backend/arch: particle engine and momentum kernels ("taichi" default, "numpy" reference); arch "cpu" or
+    "cuda" (float64 kernels: Taichi's other backends lack it), None: HFGPU_ARCH or cpu.
     particles_per_parcel: real particles per parcel for every class; when None, it is chosen per class so
     that ``parcels_per_cell`` parcels fill a cell at the class's largest volume fraction (initial or
     injected).
@@ -308,7 +309,7 @@ def _parse_mppic(t: Table, preset: Preset = BALANCED) -> tuple[MppicNumerics, An
     backend = t.choice("backend", BACKENDS, d.backend)
     arch = t.raw("arch", None)
     if arch is not None:
-        arch = t.choice("arch", ("cpu", "gpu", "cuda", "vulkan", "metal"))
+        arch = t.choice("arch", ARCHES)
     numerics = MppicNumerics(
         backend=backend,
         arch=arch,

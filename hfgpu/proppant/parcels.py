@@ -84,14 +84,18 @@ class Parcels:
             setattr(self, name, np.ascontiguousarray(getattr(self, name)[order]))
 
     def sort_by_cell(self, frame: GridFrame, shape: tuple[int, int]) -> None:
-        """Order the parcels by half-cell (row-major in depth, then x), so that neighbours in memory share their
-        bilinear stencils: the Taichi deposits then sum runs locally and need few atomics. Stable sort, cheap
-        when the parcels are nearly sorted already (call it every few steps); results are unchanged up to
-        round-off. ``frame`` is the GridFrame of a grid of ``shape`` (nz, nx)."""
+        """Order the parcels by half-cell (cell_keys, a stable sort), so that neighbours in memory share their
+        bilinear stencils: the Taichi deposits then sum runs locally and need few atomics. The Taichi engine
+        sorts its parcels the same way at the start of every fluid step (kernels/store.py)."""
+        self.reorder(np.argsort(self.cell_keys(frame, shape), kind="stable"))
+
+    def cell_keys(self, frame: GridFrame, shape: tuple[int, int]) -> np.ndarray:
+        """Half-cell index of each parcel, row-major in depth, then x, clipped into the grid's (2 nz + 2) x
+        (2 nx + 2) half cells; ``frame`` is the GridFrame of a grid of ``shape`` (nz, nx)."""
         nz, nx = shape
         kq = np.clip(np.floor(2.0 * (self.z - frame.z0) / frame.dz).astype(np.int64) + 1, 0, 2 * nz + 1)
         iq = np.clip(np.floor(2.0 * (self.x - frame.x0) / frame.dx).astype(np.int64) + 1, 0, 2 * nx + 1)
-        self.reorder(np.argsort(kq * (2 * nx + 2) + iq, kind="stable"))
+        return kq * (2 * nx + 2) + iq
 
     def particle_volume(self) -> np.ndarray:
         """Volume of one particle of each parcel, 4/3 pi r^3 [m^3]."""

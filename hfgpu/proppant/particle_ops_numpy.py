@@ -1,8 +1,8 @@
-"""MP-PIC particle operations, NumPy reference (test oracle of the Taichi kernels in ``hfgpu.kernels``).
-
-Grid-side steps that cost O(cells) (finishing the scattered moments, face gradients, damping rates) are shared
-by both backends; the per-parcel steps (``moment_sums``, ``gather``, ``push``, ``exchange``) have a NumPy
-version here and a Taichi version in ``kernels/particles.py``. See ``backend.py`` for the API.
+"""MP-PIC particle operations, NumPy reference (the test oracle of the Taichi kernels in ``hfgpu.kernels``):
+scatter (``moment_sums``, ``finish_moments``, Eq. 38), grid fields (``grid_fields``), gather (Eq. 40-41), push
+(Eq. 43-44), exchange (Eq. 39, with ``pressure_reaction``) and the implicit-drag lag (``parcel_response``).
+:class:`hfgpu.proppant.engine_numpy.NumpyEngine` runs them as a sub-loop; kernels/particles.py and
+kernels/grid.py are the Taichi versions, pass for pass.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import numpy as np
 
 from ..records import GridFrame
 from . import closures
+from .grid import face_mean
 from .interpolation import active_nodes, deposit, face_widths, interpolate, owning_cell, weights
 from .params import MppicParams
 from .parcels import BRIDGED, SUSPENDED, Parcels
@@ -323,21 +324,26 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
 
 def exchange(parcels: Parcels, seen: ParcelFluid, drag: np.ndarray, frame: GridFrame,
              width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Interphase momentum transfer per unit volume at active faces, F_x (nz, nx+1), F_z (nz+1, nx) [N/m^3]
-    (Eq. 39): sum n rho_p V_p [D (u_f - u_p) - grad p / rho_p] I / V_face, V_face = dx dz w_face; it is the
-    force of the fluid on the particles (the fluid gets -F, Eq. 26). Uses the parcels' current positions and
-    velocities (after ``push``: u^{n+1}, the implicit drag velocity) and the D returned by ``push``."""
+    """The drag part of the interphase momentum transfer per unit volume at active faces, F_x (nz, nx+1), F_z
+    (nz+1, nx) [N/m^3] (Eq. 39): sum n rho_p V_p D (u_f - u_p) I / V_face, V_face = dx dz w_face; it is the force
+    of the fluid on the particles (the fluid gets -F, Eq. 26). The pressure part of Eq. 39 is pressure_reaction's.
+    Uses the parcels' current positions and velocities (after ``push``: u^{n+1}, the implicit drag velocity),
+    the u_f they saw before it and the D returned by ``push``."""
+    rate = parcels.solid_volume() * parcels.density * drag
+    return face_sums(parcels, rate * (seen.fluid_u - parcels.u), rate * (seen.fluid_v - parcels.v), frame, width)
+
+
+def face_sums(parcels: Parcels, values_x: np.ndarray, values_z: np.ndarray, frame: GridFrame,
+              width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per-parcel values deposited with x-face and z-face weights (Eq. 37), per unit face volume dx dz w_face:
+    sum value I / V_face on the x-faces (nz, nx+1) and the z-faces (nz+1, nx), 0 at inactive faces."""
     check_width(width)
     _, xmask, zmask = active_nodes(width)
     wxf, wzf = face_widths(width)
-    vol = parcels.solid_volume()
-    mass = vol * parcels.density
-    fx = mass * drag * (seen.fluid_u - parcels.u) - vol * seen.dpdx
-    fz = mass * drag * (seen.fluid_v - parcels.v) - vol * seen.dpdz
     k, i, w = weights(parcels.x, parcels.z, frame, "xface", xmask)
-    sx = deposit(fx, k, i, w, xmask.shape)
+    sx = deposit(values_x, k, i, w, xmask.shape)
     k, i, w = weights(parcels.x, parcels.z, frame, "zface", zmask)
-    sz = deposit(fz, k, i, w, zmask.shape)
+    sz = deposit(values_z, k, i, w, zmask.shape)
     return per_face_volume(sx, frame, wxf), per_face_volume(sz, frame, wzf)
 
 
@@ -345,3 +351,36 @@ def per_face_volume(sums: np.ndarray, frame: GridFrame, face_width: np.ndarray) 
     """Face sums divided by V_face = dx dz w_face (Eq. 39; 0 at inactive faces)."""
     volume = frame.dx * frame.dz * face_width
     return np.divide(sums, volume, out=np.zeros_like(sums), where=face_width > 0.0)
+
+
+def pressure_reaction(fields: GridFields) -> tuple[np.ndarray, np.ndarray]:
+    """The pressure part of Eq. 39 on the faces, -sum n V_p grad p I / V_face, with each face's own gradient
+    (the one the fluid feels there) instead of the gradient interpolated at the parcels (Eq. 41): -theta_p,f
+    grad p_f, theta_p,f = (theta_p w)_f / w_f the face mean of Eq. 38's fraction (as the fluid's (theta_f w)_f),
+    so that the fluid feels -grad p + theta_p,f grad p = -theta_f,f grad p (Eq. 8 with Eq. 19) face by face.
+    Why: Eq. 41 spreads a face's gradient over the parcels a cell either side, and Eq. 39 deposits it back on
+    the faces a cell further on; beside a packed inlet, whose gradient is 100-1000 times that of the open
+    fracture next to it, that moved more than the whole local pressure force onto the open faces around it,
+    pushed the fluid towards the high pressure and drove eddies at 3-6 m/s (tests/proppant/test_inlet_speeds.py).
+    The gradient is the old pressure's, the one the parcels feel: taken implicitly (the fluid feeling
+    theta_f grad p^(n+1)), the loop parcels -> continuity -> pressure -> parcels gained theta_p / theta_f per
+    step and oscillated in settling beds above theta_p = 0.5."""
+    is_open = fields.width > 0.0
+    load = fields.volume_fraction * fields.width
+    out = []
+    for axis, gradient in ((1, fields.dpdx), (0, fields.dpdz)):
+        w_f = face_mean(fields.width, is_open, axis)
+        theta = np.divide(face_mean(load, is_open, axis), w_f, out=np.zeros_like(w_f), where=w_f > 0.0)
+        out.append(-theta * gradient)
+    return out[0], out[1]
+
+
+def parcel_response(lag: np.ndarray, velocity: np.ndarray, drag: np.ndarray, h: float,
+                    held: np.ndarray) -> np.ndarray:
+    """1 - r after one more sub-step h of Eq. 43: a parcel following the fluid keeps 1/(1 + D h) of the lag
+    it had (r = (r^o + D h)/(1 + D h); the collision damping relaxes a parcel towards its cell's mean velocity,
+    which follows u_f as the parcel does). Lag 1 (no response) where the push stopped the parcel (velocity
+    exactly 0) or where it is ``held`` in a dense bed, whose packing stress (Eq. 16, the limiter, the packing
+    cap) and collision damping, not drag alone, set its velocity (``held``: theta_p >= damping_threshold x
+    theta_cp)."""
+    return np.where((velocity == 0.0) | held, 1.0, lag / (1.0 + drag * h))

@@ -6,12 +6,13 @@ particle sub-step; a step whose Courant number comes out above C_max is undone, 
 1. the parcels entering during the step are added (:mod:`hfgpu.proppant.injection`);
 2. particle sub-loop (section 4.3), ``particle_substeps`` times dt/n in the fluid of the step's start:
    scatter (Eq. 38) -> gather (Eq. 40-41) -> push (Eq. 43-44) -> exchange (Eq. 39); parcels in outlet cells
-   are removed and their solid volume counted;
+   are removed and their solid volume counted. The particle engine (:mod:`hfgpu.proppant.engine`: Taichi
+   kernels, or the NumPy oracle) owns the parcels and runs the whole sub-loop per call;
 3. scatter: theta_p at the step's end, so that the fluid's storage term (theta_f w - theta_f^o w^o)/dt of
    Eq. 25 is the change over this very step;
 4. fluid SIMPLE step (Algorithm 1) with theta_f = 1 - theta_p, the interphase force F averaged over the
-   sub-loop (its pressure part with each face's own gradient, see pressure_reaction), the inlets' fluid sources
-   (1 - c) Q (and the momentum of jet inlets), leak-off and the outlets;
+   sub-loop (its pressure part with each face's own gradient, see particle_ops_numpy.pressure_reaction), the
+   inlets' fluid sources (1 - c) Q (and the momentum of jet inlets), leak-off and the outlets;
 5. a :class:`hfgpu.records.SolidBalanceRecord` goes to the sink; snapshots every ``output.every``.
 This is the cycle scatter -> fluid -> particles of the paper entered at the particles: each fluid step sees
 the force of the particle sub-loop over the same interval.
@@ -26,7 +27,7 @@ time, volume). A growing fracture can drive the loop through ``width_field(t) ->
 
 The drag part of F is also handed to the fluid step as beta = sum n rho_p V_p D_p (1 - r_p) I / V_face, so
 that the fluid takes F = F^o + beta (u_f - u_f^o) implicitly, r_p being the share of a change of u_f that the
-parcel's own implicit update (Eq. 43) follows within the step (parcel_response). F^o is the drag on the parcels
+parcel's own implicit update (Eq. 43) follows within the step (particle_ops_numpy.parcel_response). F^o is the drag on the parcels
 pushed through the old fluid; with the drag implicit in both phases, F = D (u_f - u_p(u_f)) and
 u_p = (u_p^o + dt (D u_f + a)) / (1 + D dt), so dF/du_f = D / (1 + D dt) per unit mass (derived here from
 Eq. 43; over sub-steps h the lag 1 - r is the product of their 1/(1 + D h)). For D dt >> 1 the fluid then
@@ -55,13 +56,12 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..records import GridFrame, ProppantSnapshot, SolidBalanceRecord
-from .backend import get_backend
 from .config import Geometry, Port, ProppantSetup
+from .engine import make_engine
 from .fluid import CourantLimitExceeded, FluidNumerics, FluidSolver, FluidState
-from .grid import StaggeredGrid, face_mean
+from .grid import StaggeredGrid
 from .injection import Injector, batch_solid_volume, initial_suspension, ports_to_cells
 from .parcels import Parcels
-from .particle_ops_numpy import GridFields, ParcelFluid, grid_fields
 
 #: fluid volumes [m^3] the fluid step reports (hfgpu.proppant.fluid.StepInfo), summed in fluid_totals
 FLUID_VOLUMES = ("injected", "opened", "supplied", "stored", "leaked", "outflow", "dropped")
@@ -98,54 +98,6 @@ def particles_per_parcel(setup: ProppantSetup, schedule, cell_volume: float) -> 
     return out
 
 
-def drag_only(seen: ParcelFluid) -> ParcelFluid:
-    """``seen`` without the pressure gradient: its exchange (Eq. 39) is the drag part of F only (the pressure
-    part comes from pressure_reaction)."""
-    zero = np.zeros_like(seen.dpdx)
-    return dataclasses.replace(seen, dpdx=zero, dpdz=zero)
-
-
-def pressure_reaction(fields: GridFields) -> tuple[np.ndarray, np.ndarray]:
-    """The pressure part of Eq. 39 on the faces, -sum n V_p grad p I / V_face, with each face's own gradient
-    (the one the fluid feels there) instead of the gradient interpolated at the parcels (Eq. 41): -theta_p,f
-    grad p_f, theta_p,f = (theta_p w)_f / w_f the face mean of Eq. 38's fraction (as the fluid's (theta_f w)_f),
-    so that the fluid feels -grad p + theta_p,f grad p = -theta_f,f grad p (Eq. 8 with Eq. 19) face by face.
-    Why: Eq. 41 spreads a face's gradient over the parcels a cell either side, and Eq. 39 deposits it back on
-    the faces a cell further on; beside a packed inlet, whose gradient is 100-1000 times that of the open
-    fracture next to it, that moved more than the whole local pressure force onto the open faces around it,
-    pushed the fluid towards the high pressure and drove eddies at 3-6 m/s (tests/proppant/test_inlet_speeds.py).
-    The gradient is the old pressure's, the one the parcels feel: taken implicitly (the fluid feeling
-    theta_f grad p^(n+1)), the loop parcels -> continuity -> pressure -> parcels gained theta_p / theta_f per
-    step and oscillated in settling beds above theta_p = 0.5."""
-    is_open = fields.width > 0.0
-    load = fields.volume_fraction * fields.width
-    out = []
-    for axis, gradient in ((1, fields.dpdx), (0, fields.dpdz)):
-        w_f = face_mean(fields.width, is_open, axis)
-        theta = np.divide(face_mean(load, is_open, axis), w_f, out=np.zeros_like(w_f), where=w_f > 0.0)
-        out.append(-theta * gradient)
-    return out[0], out[1]
-
-
-def unit_slip(seen: ParcelFluid, parcels: Parcels, lag_x: np.ndarray, lag_z: np.ndarray) -> ParcelFluid:
-    """``seen`` with a fluid velocity faster than each parcel by its lag (1 - r_p, parcel_response) in x and z
-    and no pressure gradient: the exchange (Eq. 39) of it is the implicit drag coefficient beta = sum n rho_p
-    V_p D_p (1 - r_p) I / V_face on the faces (module docstring)."""
-    zero = np.zeros_like(seen.dpdx)
-    return dataclasses.replace(seen, fluid_u=parcels.u + lag_x, fluid_v=parcels.v + lag_z, dpdx=zero, dpdz=zero)
-
-
-def parcel_response(lag: np.ndarray, velocity: np.ndarray, drag: np.ndarray, h: float,
-                    held: np.ndarray) -> np.ndarray:
-    """1 - r after one more sub-step h of Eq. 43: a parcel following the fluid keeps 1/(1 + D h) of the lag
-    it had (r = (r^o + D h)/(1 + D h); the collision damping relaxes a parcel towards its cell's mean velocity,
-    which follows u_f as the parcel does). Lag 1 (no response) where the push stopped the parcel (velocity
-    exactly 0) or where it is ``held`` in a dense bed, whose packing stress (Eq. 16, the limiter, the packing
-    cap) and collision damping, not drag alone, set its velocity (``held``: theta_p >= damping_threshold x
-    theta_cp)."""
-    return np.where((velocity == 0.0) | held, 1.0, lag / (1.0 + drag * h))
-
-
 @dataclass(frozen=True)
 class StepInfo:
     """What one fluid step did."""
@@ -179,35 +131,35 @@ class ProppantSimulation:
         self.rho_f = scene.fluid.density
         self.mu_f = scene.fluid.viscosity
         self.width_field = width_field
-        self.backend = get_backend(self.numerics.backend, arch=self.numerics.arch)
         self.grid = build_grid(setup.geometry, scene.mesh)
         self.leakoff = np.zeros(self.grid.shape)
         if width_field is not None:
             self._set_width(0.0)
+        self.outlets = np.zeros(self.grid.shape, dtype=bool)
+        for k, i in ports_to_cells(setup.geometry.outlets, self.grid.frame, self.grid.width,
+                                   "geometry.outlets"):
+            self.outlets[k, i] = True
+        self.engine = make_engine(self.numerics.backend, self.grid, self.params, self.rho_f, self.mu_f,
+                                  self.numerics.gravity, self.outlets, arch=self.numerics.arch)
         self.time = 0.0
         self.rng = np.random.default_rng(scene.run.seed)
         open_volume = self.grid.cell_volume[self.grid.active]
         schedule = scene.injection.schedule if scene.injection is not None else None
         self.particles_per_parcel = particles_per_parcel(setup, schedule, float(np.median(open_volume)))
-        self.parcels = Parcels.empty()
         self.injected = 0.0
         self.outflow = 0.0
         self.screen_out_time = math.nan  # start of the first step whose inlets held proppant back
         self.add_parcels(initial_suspension(setup.classes, self.grid.frame, self.grid.width,
                                             self.particles_per_parcel, self.rng))
         self.injector = self._make_injector(schedule)
-        self.outlets = np.zeros(self.grid.shape, dtype=bool)
-        for k, i in ports_to_cells(setup.geometry.outlets, self.grid.frame, self.grid.width,
-                                   "geometry.outlets"):
-            self.outlets[k, i] = True
-        self.moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
+        self.moments = self.engine.moments()
         n = self.numerics
         self.solver = FluidSolver(self.grid, self.rho_f, self.mu_f,
                                   FluidNumerics(c_max=n.c_max, tolerance=n.simple_tolerance,
                                                 max_iterations=n.simple_max_iterations),
-                                  self.backend,
+                                  self.engine,
                                   params=self.params if n.slurry_viscosity else None,
-                                  wall_friction=self.params.wall_friction)
+                                  wall_friction=self.params.wall_friction, arch=self.engine.arch)
         self.fluid = self.solver.initial_state(self._fluid_theta_p())
         self.steps = 0
         self.safety = 1.0
@@ -238,8 +190,18 @@ class ProppantSimulation:
     def add_parcels(self, batch: dict[str, np.ndarray]) -> None:
         """Place parcels (shared layout arrays) in the domain; their solid volume counts as injected."""
         if batch["x"].size:
-            self.parcels.append(Parcels(**batch))
+            self.engine.append(Parcels(**batch))
             self.injected += batch_solid_volume(batch)
+
+    @property
+    def parcels(self) -> Parcels:
+        """A host copy of the parcels (read back from the engine)."""
+        return self.engine.parcels()
+
+    def set_parcels(self, parcels: Parcels) -> None:
+        """Replace the parcels (their volume is not counted as injected: a test's or a restart's)."""
+        self.engine.set_parcels(parcels)
+        self.moments = self.engine.moments()
 
     # -- stepping -------------------------------------------------------------------------------------
 
@@ -249,36 +211,39 @@ class ProppantSimulation:
         is scaled by ``safety``, which shrinks by 0.7 after a step needed a retry and recovers by 1.05 a step."""
         h = min(self.grid.frame.dx, self.grid.frame.dz)
         dt = min(self.numerics.dt_max, limit, self.safety * self.solver.stable_dt(self.fluid))
-        if self.parcels.n:
-            speed = float(np.max(np.abs(self.parcels.u) + np.abs(self.parcels.v)))
-            if speed > 0.0:
-                dt = min(dt, self.numerics.c_max * h * self.numerics.particle_substeps / speed)
+        speed = self.engine.max_speed()
+        if speed > 0.0:
+            dt = min(dt, self.numerics.c_max * h * self.numerics.particle_substeps / speed)
         return dt
 
     def step(self, limit: float = math.inf) -> StepInfo:
-        """Advance one fluid step (at most ``limit`` seconds); see the module docstring."""
+        """Advance one fluid step (at most ``limit`` seconds); see the module docstring. A retry starts again
+        from the parcels of the last accepted step (the engine keeps them until ``commit``)."""
         dt = self.next_dt(limit)
         t0 = self.time
-        saved = self._save()
+        saved = (copy.deepcopy(self.injector), self.injected, self.screen_out_time)
         for retry in range(self.numerics.max_step_retries + 1):
             if retry:
-                self._restore(saved)
+                injector, self.injected, self.screen_out_time = saved
+                self.injector = copy.deepcopy(injector)
             if self.width_field is not None:
                 self._set_width(t0 + dt)
                 self.solver.set_grid(self.grid)
+                self.engine.set_grid(self.grid)
             if not (dt > 0.0 and t0 + dt > t0):
                 raise SimulationError(f"zero-length time step (dt = {dt:g} s)", time=t0)
+            self.engine.begin_step(self.fluid.u, self.fluid.v, self.fluid.p)
             if self.injector is not None:
                 self._inject(t0, t0 + dt)
-            force = self._particle_subloop(dt, t0)
-            self.moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
+            loop = self.engine.substeps(dt, self.numerics.particle_substeps, t0)
+            self.moments = self.engine.moments()
             sources, momentum = ((self.injector.fluid_sources(t0, t0 + dt), self.injector.jet_momentum(t0, t0 + dt))
                                  if self.injector is not None else (np.zeros(self.grid.shape), (None, None)))
             trial = self.solver.copy_state(self.fluid)
             try:
-                info = self.solver.step(trial, dt, self._fluid_theta_p(), force[0],
-                                        force[1], sources=sources, leakoff=self.leakoff, outlets=self.outlets,
-                                        drag_x=force[2], drag_z=force[3], momentum_x=momentum[0],
+                info = self.solver.step(trial, dt, self._fluid_theta_p(), loop.force_x, loop.force_z,
+                                        sources=sources, leakoff=self.leakoff, outlets=self.outlets,
+                                        drag_x=loop.beta_x, drag_z=loop.beta_z, momentum_x=momentum[0],
                                         momentum_z=momentum[1])
             except CourantLimitExceeded as exc:
                 dt = min(0.5 * dt, exc.stable_dt)
@@ -289,6 +254,8 @@ class ProppantSimulation:
         else:
             raise SimulationError(f"the fluid Courant number stayed above c_max = {self.numerics.c_max:g} "
                                   f"after {self.numerics.max_step_retries} reductions of the step", time=t0)
+        self.engine.commit()
+        self.outflow += loop.outflow
         self.fluid = trial
         for name in FLUID_VOLUMES:
             self.fluid_totals[name] += getattr(info, name)
@@ -298,13 +265,13 @@ class ProppantSimulation:
         self.steps += 1
         return StepInfo(time=self.time, dt=dt, simple_iterations=info.iterations,
                         continuity_residual=info.continuity_residual, courant=info.courant,
-                        parcels=self.parcels.n, retries=retry)
+                        parcels=self.engine.live, retries=retry)
 
     def _inject(self, t0: float, t1: float) -> None:
         """Add the inlets' parcels for (t0, t1] into the room left below close packing, theta_cp V_cell minus
         the solid volume of the scatter (Eq. 38) on the step's width, and none where the width is below the
         largest grain; what cannot enter is screened out."""
-        moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
+        moments = self.engine.moments()
         room = np.maximum(self.params.theta_cp * self.grid.cell_volume - moments.solid_volume, 0.0)
         room[self.grid.width < max(c.size.d_max for c in self.setup.classes)] = 0.0
         held = self.injector.screened_out
@@ -325,63 +292,6 @@ class ProppantSimulation:
         w)^o must follow the parcels, or a bed reaching theta_cp breaks continuity (seen to blow up)."""
         return np.minimum(self.moments.volume_fraction, 1.0 - 1e-6)
 
-    def _save(self) -> tuple:
-        """What a step changes before its Courant check, to undo it for a retry."""
-        return (self.parcels.copy(), copy.deepcopy(self.injector), self.injected, self.outflow, self.grid,
-                self.leakoff, self.screen_out_time)
-
-    def _restore(self, saved: tuple) -> None:
-        parcels, injector, self.injected, self.outflow, self.grid, self.leakoff, self.screen_out_time = saved
-        self.parcels, self.injector = parcels.copy(), copy.deepcopy(injector)
-        self.solver.set_grid(self.grid)
-
-    def _particle_subloop(self, dt: float, t0: float) -> tuple[np.ndarray, ...]:
-        """``particle_substeps`` x (scatter, gather, push, exchange, outlets) in the fluid of the step's start;
-        returns F_x, F_z (Eq. 39: drag_only plus pressure_reaction) and beta_x, beta_z averaged over the
-        sub-steps."""
-        n = self.numerics.particle_substeps
-        h = dt / n
-        frame, width = self.grid.frame, self.grid.width
-        nz, nx = self.grid.shape
-        fx, bx = np.zeros((nz, nx + 1)), np.zeros((nz, nx + 1))
-        fz, bz = np.zeros((nz + 1, nx)), np.zeros((nz + 1, nx))
-        lag_x, lag_z = np.ones(self.parcels.n), np.ones(self.parcels.n)
-        for s in range(n):
-            moments = self.backend.scatter(self.parcels, frame, width)
-            fields = grid_fields(frame, width, self.fluid.u, self.fluid.v, self.fluid.p, moments, self.params)
-            seen = self.backend.gather(self.parcels, frame, fields)
-            drag = self.backend.push(self.parcels, seen, frame, fields, h, self.params, self.rho_f, self.mu_f,
-                                     self.numerics.gravity)
-            force = self.backend.exchange(self.parcels, drag_only(seen), drag, frame, width)
-            reaction = pressure_reaction(fields)
-            fx += (force[0] + reaction[0]) / n
-            fz += (force[1] + reaction[1]) / n
-            held = seen.volume_fraction >= self.params.damping_threshold * self.params.theta_cp
-            lag_x = parcel_response(lag_x, self.parcels.u, drag, h, held)
-            lag_z = parcel_response(lag_z, self.parcels.v, drag, h, held)
-            beta = self.backend.exchange(self.parcels, unit_slip(seen, self.parcels, lag_x, lag_z), drag, frame,
-                                         width)
-            bx += beta[0] / n
-            bz += beta[1] / n
-            self._check_parcels(t0 + (s + 1) * h)
-            kept = self._remove_outflow()
-            lag_x, lag_z = lag_x[kept], lag_z[kept]
-        return fx, fz, bx, bz
-
-    def _remove_outflow(self) -> np.ndarray:
-        """Drop the parcels in outlet cells (their solid volume counted as outflow); returns the mask of the
-        parcels kept, over the parcels before the call."""
-        if not self.outlets.any() or self.parcels.n == 0:
-            return np.ones(self.parcels.n, dtype=bool)
-        frame = self.grid.frame
-        i = np.clip(np.floor((self.parcels.x - frame.x0) / frame.dx + 0.5).astype(int), 0, self.grid.nx - 1)
-        k = np.clip(np.floor((self.parcels.z - frame.z0) / frame.dz + 0.5).astype(int), 0, self.grid.nz - 1)
-        leaving = self.outlets[k, i]
-        if leaving.any():
-            self.outflow += float(np.sum(self.parcels.solid_volume()[leaving]))
-            self.parcels.drop(leaving)
-        return ~leaving
-
     def _check_fluid(self, t: float) -> None:
         for name in ("u", "v", "p"):
             values = getattr(self.fluid, name)
@@ -390,21 +300,11 @@ class ProppantSimulation:
                 cell = tuple(int(c) for c in np.argwhere(bad)[0])
                 raise SimulationError(f"non-finite fluid {name}", time=t, cell=cell)
 
-    def _check_parcels(self, t: float) -> None:
-        p = self.parcels
-        bad = ~(np.isfinite(p.x) & np.isfinite(p.z) & np.isfinite(p.u) & np.isfinite(p.v))
-        if bad.any():
-            j = int(np.argmax(bad))
-            frame = self.grid.frame
-            cell = (int(math.floor((p.z[j] - frame.z0) / frame.dz + 0.5)) if np.isfinite(p.z[j]) else None,
-                    int(math.floor((p.x[j] - frame.x0) / frame.dx + 0.5)) if np.isfinite(p.x[j]) else None)
-            raise SimulationError(f"non-finite state of parcel {j}", time=t, cell=cell)
-
     # -- records --------------------------------------------------------------------------------------
 
     def snapshot(self) -> ProppantSnapshot:
         """Parcels and grid fields now (the records' layout)."""
-        self.moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
+        self.moments = self.engine.moments()
         return ProppantSnapshot(
             time=self.time, frame=self.grid.frame, parcels=self.parcels.as_dict(),
             grid=dict(volume_fraction=self.moments.volume_fraction.copy(), pressure=self.fluid.p.copy(),
@@ -413,7 +313,7 @@ class ProppantSimulation:
 
     def balance(self) -> SolidBalanceRecord:
         return SolidBalanceRecord(time=self.time, injected=self.injected,
-                                  in_domain=float(np.sum(self.parcels.solid_volume())), outflow=self.outflow,
+                                  in_domain=self.engine.solid_volume(), outflow=self.outflow,
                                   screened_out=self.screened_out)
 
     def run(self, sink, progress: Callable[[float], None] | None = None,
@@ -454,10 +354,11 @@ class ProppantSimulation:
         if abs(self.time - (next_out - every)) > eps:
             sink.proppant_snapshot(self.snapshot())
         record = self.balance()
-        return dict(time=self.time, steps=self.steps, parcels=self.parcels.n, injected=record.injected,
+        return dict(time=self.time, steps=self.steps, parcels=self.engine.live, injected=record.injected,
                     in_domain=record.in_domain, outflow=record.outflow, screened_out=record.screened_out,
                     screen_out_time=self.screen_out_time,
-                    max_continuity_residual=max_residual, backend=self.numerics.backend,
+                    max_continuity_residual=max_residual, backend=self.engine.name, arch=self.engine.arch,
+                    threads=self.engine.threads or 0,
                     **{f"fluid_{name}": value for name, value in self.fluid_totals.items()})
 
     # -- checkpoints ------------------------------------------------------------------------------------
@@ -487,10 +388,11 @@ class ProppantSimulation:
         for name in self.STATE_ATTRIBUTES:
             setattr(self, name, np.array(state[name]) if isinstance(state[name], np.ndarray) else state[name])
         self.fluid_totals = {name: float(state["fluid_totals"][name]) for name in FLUID_VOLUMES}
-        self.parcels = Parcels(**{name: np.array(a) for name, a in state["parcels"].items()})
         self.grid = self.grid.with_width(np.array(state["width"]))
         self.leakoff = np.array(state["leakoff"])
         self.solver.set_grid(self.grid)
+        self.engine.set_grid(self.grid)
+        self.engine.set_parcels(Parcels(**{name: np.array(a) for name, a in state["parcels"].items()}))
         self.solver.linear.restore(state["linear"])
         self.fluid = FluidState(**{name: np.array(a) for name, a in state["fluid"].items()})
         self.rng.bit_generator.state = json.loads(state["rng"])
@@ -500,7 +402,7 @@ class ProppantSimulation:
             for inlet, owed, diameter in zip(self.injector.inlets, state["injector"]["owed"],
                                              state["injector"]["next_diameter"]):
                 inlet.owed, inlet.next_diameter = np.array(owed), np.array(diameter)
-        self.moments = self.backend.scatter(self.parcels, self.grid.frame, self.grid.width)
+        self.moments = self.engine.moments()
 
 
 def warn_screen_out(summary: dict, theta_cp: float, offset: float = 0.0) -> None:

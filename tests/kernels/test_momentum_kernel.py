@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from hfgpu.proppant.backend import get_backend
+from hfgpu.proppant.engine_numpy import NumpyEngine
+from hfgpu.proppant.engine_taichi import TaichiEngine
 from hfgpu.proppant.momentum import momentum_predictor as reference
 
 
@@ -32,7 +33,7 @@ def test_kernel_matches_numpy(nz, nx, closed, wall_friction):
         fields["wall_friction"] = "dean"
     # cell Peclet numbers span both branches of the power law (|P| < 10 and A = 0 beyond)
     expected = reference(**fields)
-    got = get_backend("taichi", arch="cpu").momentum_predictor(**fields)
+    got = TaichiEngine.momentum_predictor(**fields)
     for name, e, g in zip(("u*", "v*", "d_u", "d_v"), expected, got):
         assert g.shape == e.shape, name
         scale = np.max(np.abs(e)) + 1e-300
@@ -46,5 +47,5 @@ def test_kernel_matches_numpy(nz, nx, closed, wall_friction):
 def test_numpy_backend_is_reference():
     rng = np.random.default_rng(3)
     fields = random_fields(rng, 5, 6, 0.2)
-    for e, g in zip(reference(**fields), get_backend("numpy").momentum_predictor(**fields)):
+    for e, g in zip(reference(**fields), NumpyEngine.momentum_predictor(**fields)):
         np.testing.assert_array_equal(g, e)

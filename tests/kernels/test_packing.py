@@ -5,15 +5,18 @@ bed friction holds grains resting on a bed or floor against a weak tangential fl
 import numpy as np
 import pytest
 
-from hfgpu.proppant.backend import get_backend, grid_fields
+from hfgpu.proppant import closures
+from hfgpu.proppant.interpolation import active_nodes, interpolate, weights
 from hfgpu.proppant.params import MppicParams
 from hfgpu.proppant.parcels import Parcels
 from hfgpu.records import GridFrame
 
-RHO_F, MU, G, DT = 1000.0, 1e-3, 9.81, 1e-3
+from .engine_step import MU, RHO_F, G, engine_for, particle_step
+
+DT = 1e-3
 
 
-def settle(backend, steps, theta0=0.2, nz=16, nx=4, rows=8, per_cell=20, seed=0):
+def settle(backend_name, steps, theta0=0.2, nz=16, nx=4, rows=8, per_cell=20, seed=0):
     """Still fluid, d = 0.45 mm sand (terminal velocity 0.067 m/s) released at theta0 in the top rows of a
     5 mm grid; returns the history of (max theta_p, mean depth, rms speed)."""
     rng = np.random.default_rng(seed)
@@ -26,21 +29,18 @@ def settle(backend, steps, theta0=0.2, nz=16, nx=4, rows=8, per_cell=20, seed=0)
     parcels = Parcels.create(rng.uniform(0, nx * d, n), rng.uniform(0, rows * d, n), radius=r,
                              density=2550.0, particles=per)
     params = MppicParams()
-    u, v, p = np.zeros((nz, nx + 1)), np.zeros((nz + 1, nx)), np.zeros((nz, nx))
+    still = dict(u=np.zeros((nz, nx + 1)), v=np.zeros((nz + 1, nx)), pressure=np.zeros((nz, nx)))
     history = []
     for _ in range(steps):
-        moments = backend.scatter(parcels, frame, width)
-        fields = grid_fields(frame, width, u, v, p, moments, params)
-        seen = backend.gather(parcels, frame, fields)
-        backend.push(parcels, seen, frame, fields, DT, params, RHO_F, MU, G)
-        history.append((moments.volume_fraction.max(), parcels.z.mean(),
+        _, engine = particle_step(backend_name, frame, width, parcels, still, params, dt=DT)
+        history.append((engine.moments().volume_fraction.max(), parcels.z.mean(),
                         np.sqrt(np.mean(parcels.u ** 2 + parcels.v ** 2))))
     return np.array(history), params, frame, parcels
 
 
 @pytest.mark.parametrize("backend_name", ["numpy", "taichi"])
 def test_settled_bed_does_not_overpack_and_stays_at_rest(backend_name):
-    history, params, frame, parcels = settle(get_backend(backend_name), steps=3000)
+    history, params, frame, parcels = settle(backend_name, steps=3000)
     theta_max, depth, speed = history.T
     # theta_p <= theta_cp (+ one step's inflow) for the whole run, impact of the falling cloud included
     assert theta_max.max() <= 1.01 * params.theta_cp
@@ -60,8 +60,8 @@ def test_bed_friction_holds_resting_grains_and_slows_sliding_ones(backend_name):
     one drag solve and no damping, Eq. 43 gives u = dt D U / (1 + dt D); friction removes
     dt mu_b (1 - rho_f/rho_p) g / (1 + dt D) of it, or all of it (static friction: held where D U < mu_b g').
     In a loose bottom row (theta_p = 0.3) it does nothing to parcels at the cell centres, but acts on the same
-    parcels lying on the floor (within one diameter of it)."""
-    backend = get_backend(backend_name)
+    parcels lying on the floor (within one diameter of it). D is Eq. 13-15 at the slip U and the theta_p the
+    parcel sees (the scatter before the push)."""
     d, w, r, rho_p = 5e-3, 2e-3, 0.225e-3, 2550.0
     frame = GridFrame(d, d, d / 2, d / 2)
     width = np.full((2, 3), w)
@@ -79,10 +79,12 @@ def test_bed_friction_holds_resting_grains_and_slows_sliding_ones(backend_name):
             for mu_b in (0.0, 0.543):
                 params = MppicParams(damping=False, drag_iterations=1, bed_friction=mu_b)
                 parcels = Parcels.create(x, z, radius=r, density=rho_p, particles=particles)
-                moments = backend.scatter(parcels, frame, width)
-                fields = grid_fields(frame, width, u, v, p, moments, params)
-                seen = backend.gather(parcels, frame, fields)
-                drag = backend.push(parcels, seen, frame, fields, DT, params, RHO_F, MU, G)
+                engine = engine_for(backend_name, frame, width, params)
+                engine.set_parcels(parcels)
+                theta_seen = interpolate(engine.moments().volume_fraction,
+                                         *weights(x, z, frame, "cell", active_nodes(width)[0]))
+                drag = closures.drag_rate(velocity, r, rho_p, theta_seen, RHO_F, MU, params)
+                particle_step(backend_name, frame, width, parcels, dict(u=u, v=v, pressure=p), params, dt=DT)
                 result[mu_b] = parcels.u.copy(), drag
             free, drag = result[0.0]
             held, _ = result[0.543]

@@ -1,12 +1,13 @@
-"""The Parcels container (shared data layout) and the particle ops on an empty parcel set."""
+"""The Parcels container (shared data layout) and the particle engines on an empty parcel set."""
 
 import numpy as np
 import pytest
 
-from hfgpu.proppant.backend import get_backend, grid_fields
 from hfgpu.proppant.params import MppicParams
 from hfgpu.proppant.parcels import Parcels
 from hfgpu.records import GridFrame
+
+from .engine_step import engine_for
 
 
 def test_append_drop_copy_and_dict():
@@ -36,15 +37,14 @@ def test_sort_by_cell_orders_by_half_cells():
 
 
 @pytest.mark.parametrize("name", ["numpy", "taichi"])
-def test_ops_accept_no_parcels(name):
-    backend = get_backend(name)
+def test_engines_accept_no_parcels(name):
     frame = GridFrame(0.01, 0.01, 0.005, 0.005)
     width = np.full((3, 4), 1e-3)
-    parcels = Parcels.empty()
-    moments = backend.scatter(parcels, frame, width)
-    assert np.all(moments.volume_fraction == 0)
-    fields = grid_fields(frame, width, np.zeros((3, 5)), np.zeros((4, 4)), np.zeros((3, 4)), moments, MppicParams())
-    seen = backend.gather(parcels, frame, fields)
-    drag = backend.push(parcels, seen, frame, fields, 1e-3, MppicParams(), 1000.0, 1e-3, 9.81)
-    fx, fz = backend.exchange(parcels, seen, drag, frame, width)
-    assert drag.size == 0 and np.all(fx == 0) and np.all(fz == 0)
+    engine = engine_for(name, frame, width, MppicParams())
+    engine.set_parcels(Parcels.empty())
+    assert np.all(engine.moments().volume_fraction == 0) and engine.max_speed() == 0.0
+    engine.begin_step(np.zeros((3, 5)), np.zeros((4, 4)), np.zeros((3, 4)))
+    loop = engine.substeps(1e-3, 2, 0.0)
+    engine.commit()
+    assert engine.parcels().n == 0 and loop.outflow == 0.0
+    assert np.all(loop.force_x == 0) and np.all(loop.force_z == 0) and np.all(loop.beta_x == 0)

@@ -58,7 +58,7 @@ def test_settled_bed_is_packed_and_its_fluid_at_rest(settled):
     adds to it) and so are its parcels (< 1e-6 m/s, median < 1e-9 m/s)."""
     sim = settled
     theta_cp = sim.params.theta_cp
-    moments = sim.backend.scatter(sim.parcels, sim.grid.frame, sim.grid.width)
+    moments = sim.engine.moments()
     assert moments.volume_fraction.max() <= 1.05 * theta_cp
     profile = row_profile(moments.volume_fraction, sim.grid.width)
     height = 0.03 * 0.2 / theta_cp
@@ -97,12 +97,12 @@ def test_dense_cell_holds_parcels_in_its_wall_half(backend_name):
     dense cell (theta_p >= friction_volume_fraction, packed or not: a bottom cell at 0.585 let its wall half
     hop down at up to 5e-3 m/s; over 30 seeds of the settled bed its deep part was above 1e-6 m/s at 4 s in 8,
     up to 1.8e-3, and is in none now) they stay (the wall is its mirror image); in a loose one they settle."""
-    from hfgpu.proppant.backend import get_backend, grid_fields
     from hfgpu.proppant.params import MppicParams
     from hfgpu.proppant.parcels import Parcels
     from hfgpu.records import GridFrame
 
-    backend = get_backend(backend_name)
+    from ..kernels.engine_step import particle_step
+
     d, w, r = 5e-3, 2e-3, 0.225e-3
     frame = GridFrame(d, d, d / 2, d / 2)
     width = np.full((4, 2), w)
@@ -116,10 +116,7 @@ def test_dense_cell_holds_parcels_in_its_wall_half(backend_name):
         per = theta * 2 * d * d * w / (4 / 3 * np.pi * r ** 3) / n
         parcels = Parcels.create(x, z, radius=r, density=2550.0, particles=per)
         parcels.v[:] = 0.05
-        moments = backend.scatter(parcels, frame, width)
-        fields = grid_fields(frame, width, u, v, p, moments, params)
-        seen = backend.gather(parcels, frame, fields)
-        backend.push(parcels, seen, frame, fields, 1e-3, params, 1000.0, 1e-3, 9.81)
+        particle_step(backend_name, frame, width, parcels, dict(u=u, v=v, pressure=p), params, dt=1e-3)
         if falls:
             assert np.all(parcels.z > 3.8 * d)
         else:

@@ -9,13 +9,14 @@ import numpy as np
 import pytest
 
 from hfgpu.proppant import closures
-from hfgpu.proppant.backend import get_backend, grid_fields
 from hfgpu.proppant.momentum import wall_friction_factor
 from hfgpu.proppant.params import MppicParams
 from hfgpu.proppant.parcels import Parcels
 from hfgpu.records import GridFrame
 
-RHO_F, MU, G, RHO_P = 1000.0, 1e-3, 9.81, 2550.0
+from ..kernels.engine_step import MU, RHO_F, G, particle_step
+
+RHO_P = 2550.0
 
 
 def test_critical_shields_number_of_sand_in_water():
@@ -68,12 +69,10 @@ def floor_case(speed, theta_cell, n=64, law="laminar"):
     return frame, width, parcels, fluid_u, params
 
 
-def push_once(backend, frame, width, parcels, fluid_u, params, dt=1e-3):
-    moments = backend.scatter(parcels, frame, width)
-    fields = grid_fields(frame, width, fluid_u, np.zeros((4, 4)), np.zeros((3, 4)), moments, params)
-    seen = backend.gather(parcels, frame, fields)
-    backend.push(parcels, seen, frame, fields, dt, params, RHO_F, MU, G)
-    return moments
+def push_once(backend_name, frame, width, parcels, fluid_u, params, dt=1e-3):
+    """One particle sub-step of the engine in the fluid velocity fluid_u along x."""
+    fluid = dict(u=fluid_u, v=np.zeros((4, 4)), pressure=np.zeros((3, 4)))
+    particle_step(backend_name, frame, width, parcels, fluid, params, dt=dt)
 
 
 def threshold_speed(law):
@@ -91,15 +90,14 @@ def test_floor_grains_stay_below_the_threshold_and_move_above_it(backend_name, l
     """Grains on the floor (loose bottom row, theta_p ~ 0.1) stop along x at 0.95 x the speed of the critical
     Shields number (0.38 m/s laminar, 0.23 m/s with Dean's friction for 0.3 mm sand in 7.62 mm) and slide
     at 1.05 x it, as fast as without the rule (it only stops; bed friction alone slows)."""
-    backend = get_backend(backend_name)
     u_c = threshold_speed(law)
     assert u_c == pytest.approx(0.381 if law == "laminar" else 0.230, rel=0.01)
     for factor, stays in ((0.95, True), (1.05, False)):
         frame, width, parcels, fluid_u, params = floor_case(factor * u_c, 0.1, law=law)
         without = parcels.copy()
         start = parcels.x.copy()
-        push_once(backend, frame, width, parcels, fluid_u, params)
-        push_once(backend, frame, width, without, fluid_u,
+        push_once(backend_name, frame, width, parcels, fluid_u, params)
+        push_once(backend_name, frame, width, without, fluid_u,
                   MppicParams(shields_deposition=False, wall_friction=law))
         if stays:
             assert np.all(parcels.u == 0.0) and np.all(without.u > 0.0)
@@ -114,13 +112,12 @@ def test_rule_leaves_suspended_and_buried_grains_alone(backend_name):
     """Grains 2 diameters and more above the floor in a loose cell (suspended) and grains in a dense bottom row
     (theta_p ~ 0.55 >= friction_volume_fraction: inside the bed, where bed friction and the packing cap act)
     move exactly as without the rule, in a flow slow enough to hold a surface grain."""
-    backend = get_backend(backend_name)
     for theta_cell, lift in ((0.1, 6 * 0.15e-3), (0.55, 0.0)):
         frame, width, parcels, fluid_u, params = floor_case(0.1, theta_cell)
         parcels.z[:] -= lift
         without = parcels.copy()
-        push_once(backend, frame, width, parcels, fluid_u, params)
-        push_once(backend, frame, width, without, fluid_u, MppicParams())
+        push_once(backend_name, frame, width, parcels, fluid_u, params)
+        push_once(backend_name, frame, width, without, fluid_u, MppicParams())
         for name in ("x", "z", "u", "v"):
             np.testing.assert_array_equal(getattr(parcels, name), getattr(without, name))
         assert np.all(parcels.u > 0.0)

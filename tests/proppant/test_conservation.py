@@ -93,9 +93,11 @@ def test_non_finite_state_raises_with_time_and_cell():
 
     sim = ProppantSimulation(load_scene(SLOT))
     sim.step()
-    sim.parcels.u[0] = np.nan
+    parcels = sim.parcels
+    parcels.x[0] = np.nan
+    sim.set_parcels(parcels)
     with pytest.raises(SimulationError, match="t = .* s.*cell"):
-        sim._check_parcels(sim.time)
+        sim.step()
 
 
 def test_proppant_run_loads_no_fracture_code_and_no_taichi_for_numpy():

@@ -32,10 +32,10 @@ def kynch(scene):
 
 def interfaces(sim: ProppantSimulation, phi_light_only: float) -> tuple[float, float]:
     """(upper, lower) interface depths [m] now."""
-    frame, width = sim.grid.frame, sim.grid.width
+    frame, width, parcels = sim.grid.frame, sim.grid.width, sim.parcels
     heavy, light = sim.setup.classes
-    theta_h = class_volume_fraction(sim.backend, sim.parcels, frame, width, 0)
-    theta_l = class_volume_fraction(sim.backend, sim.parcels, frame, width, 1)
+    theta_h = class_volume_fraction(parcels, frame, width, 0)
+    theta_l = class_volume_fraction(parcels, frame, width, 1)
     return (interface_depth(row_profile(theta_l, width), frame, 0.5 * phi_light_only),
             interface_depth(row_profile(theta_h, width), frame, 0.5 * heavy.initial_volume_fraction))
 

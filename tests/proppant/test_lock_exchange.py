@@ -63,7 +63,7 @@ parcels_per_cell = 8
 def heavy_front(sim: ProppantSimulation) -> float:
     """x of the right edge of the last bottom-row cell holding at least half the lock's theta_p."""
     frame = sim.grid.frame
-    theta = sim.backend.scatter(sim.parcels, frame, sim.grid.width).volume_fraction[-1]
+    theta = sim.engine.moments().volume_fraction[-1]
     heavy = np.nonzero(theta >= 0.5 * THETA)[0]
     return frame.x0 + (heavy.max() + 0.5) * frame.dx
 
@@ -71,8 +71,9 @@ def heavy_front(sim: ProppantSimulation) -> float:
 def test_lock_exchange_front_runs_at_the_inertial_speed():
     scene = load_scene(SCENE)
     sim = ProppantSimulation(scene)
-    sim.parcels.drop(sim.parcels.x > 0.5 * LENGTH)  # the lock: suspension in the left half only
-    sim.moments = sim.backend.scatter(sim.parcels, sim.grid.frame, sim.grid.width)
+    parcels = sim.parcels
+    parcels.drop(parcels.x > 0.5 * LENGTH)  # the lock: suspension in the left half only
+    sim.set_parcels(parcels)
     sim.fluid = sim.solver.initial_state(sim._fluid_theta_p())
     times, fronts = [], []
     for t in np.arange(0.1, 2.0 + 1e-9, 0.1):

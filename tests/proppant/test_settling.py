@@ -73,7 +73,7 @@ def top_interface_speed(text: str, t_fit: tuple[float, float]) -> tuple[float, f
     while sim.time < t_fit[1] - 1e-9:
         sim.step(limit=t_fit[1] - sim.time)
         if sim.time >= t_fit[0] - 1e-9:
-            theta = sim.backend.scatter(sim.parcels, sim.grid.frame, sim.grid.width).volume_fraction
+            theta = sim.engine.moments().volume_fraction
             times.append(sim.time)
             depths.append(interface_depth(row_profile(theta, sim.grid.width), sim.grid.frame, 0.5 * phi0))
     mid = (sim.parcels.z > depths[-1] + 0.01) & (sim.parcels.z < depths[-1] + 0.02)  # above the bed

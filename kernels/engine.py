@@ -1,0 +1,149 @@
+"""The launches of the MP-PIC engine (hfgpu.proppant.engine_taichi): each kernel is one launch made of the
+passes of kernels.particles, kernels.grid and kernels.store, run one after another (every top-level loop of a
+Taichi kernel is a parallel pass; the next starts when it ends). Layout of the arguments: kernels.layout.
+
+A fluid step of the engine is: ``begin_step`` (sort and compact the parcels into the work buffer, load the
+fluid), [``moments`` for the inlets' room, ``append``], ``substep`` x n, ``read_faces``, ``moments``,
+``read_cells``. Only
+the arguments typed NUMPY cross between host and device; everything else stays where the kernels run.
+"""
+
+from hfgpu.kernels import grid, particles, store
+from hfgpu.kernels.layout import (GONE, NO_BAD, P_DX, P_DZ, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW,
+                                  ST_SPEED, ST_VOLUME, STATE, U, V)
+from hfgpu.kernels.runtime import ti
+
+F1 = ti.types.ndarray(dtype=ti.f64, ndim=1)
+F2 = ti.types.ndarray(dtype=ti.f64, ndim=2)
+F3 = ti.types.ndarray(dtype=ti.f64, ndim=3)
+F4 = ti.types.ndarray(dtype=ti.f64, ndim=4)
+L1 = ti.types.ndarray(dtype=ti.i64, ndim=1)
+I2 = ti.types.ndarray(dtype=ti.i32, ndim=2)
+
+
+@ti.func
+def block_sum(BS: ti.template(), row: ti.template(), blocks: ti.i32, ST: ti.template(), slot: ti.template()):
+    """ST[slot] += BS[row, 0] + BS[row, 1] + ... in block order (serial: the same sum on every run)."""
+    ti.loop_config(serialize=True)
+    for b in range(blocks):
+        ST[slot] += BS[row, b]
+
+
+@ti.func
+def max_speed(P: ti.template(), S: ti.template(), n: ti.i32, ST: ti.template()):
+    """ST[ST_SPEED] = max |u| + |v| over the parcels not GONE (0 without any)."""
+    ST[ST_SPEED] = 0.0
+    for p in range(n):
+        if S[STATE, p] != GONE:
+            ti.atomic_max(ST[ST_SPEED], ti.abs(P[U, p]) + ti.abs(P[V, p]))
+
+
+@ti.kernel
+def set_grid(width: F2, outlets: I2, C: F3, XF: F3, ZF: F3, FLAGS: I2, PR: F1):
+    """A new width field (and the outlet cells) from the host: masks, face widths, stencil flags."""
+    grid.set_cells(width, outlets, C)
+    grid.set_faces(width, XF, 1)
+    grid.set_faces(width, ZF, 0)
+    grid.flags_pass(C, FLAGS, PR)
+
+
+@ti.kernel
+def begin_step(P: F2, S: I2, P2: F2, S2: I2, keys: L1, counts: L1, n: ti.i32, stable: ti.template(),
+               u: F2, v: F2, pressure: F2, C: F3, XF: F3, ZF: F3, PR: F1, ST: F1):
+    """The accepted parcels P, S sorted by cell into the work buffer P2, S2 without those that left (their
+    count in ST[ST_LIVE]); the fluid of the step's start (u, v, pressure: NUMPY, from the host's solver)."""
+    store.counting_sort(P, S, P2, S2, keys, counts, n, C.shape[1], C.shape[2], stable, PR, ST)
+    grid.load_faces(u, pressure, XF, PR[P_DX], 1)
+    grid.load_faces(v, pressure, ZF, PR[P_DZ], 0)
+    grid.load_pressure(pressure, C)
+
+
+@ti.kernel
+def substep(P: F2, S: I2, W: F2, C: F3, XF: F3, ZF: F3, FLAGS: I2, CD: F4, XD: F4, ZD: F4, BS: F2, PR: F1,
+            ST: F1, n: ti.i32, blocks: ti.i32, copies: ti.i32, private: ti.template(), h: ti.f64, step: ti.i32,
+            substeps: ti.f64):
+    """One particle sub-step of length h (the ``step``-th of ``substeps``): scatter (Eq. 38) -> cell fields
+    (theta_p, tau, damping, flags) -> stress gradients -> gather (Eq. 40-41) -> push (Eq. 43-44) -> exchange
+    (Eq. 39) with the outlets and the finiteness check -> face means of F and beta over the sub-loop."""
+    if step == 0:
+        ST[ST_OUTFLOW] = 0.0
+        ST[ST_LEFT] = 0.0
+        ST[ST_BAD_STEP] = NO_BAD
+        ST[ST_BAD_PARCEL] = NO_BAD
+    ST[ST_SPEED] = 0.0
+    grid.zero_copies(CD, copies)
+    grid.zero_copies(XD, copies)
+    grid.zero_copies(ZD, copies)
+    particles.scatter_pass(P, S, n, C, FLAGS, CD, BS, blocks, private, PR)
+    grid.finish_cells(C, CD, copies, PR)
+    grid.flags_pass(C, FLAGS, PR)
+    grid.stress_gradient(C, XF, PR[P_DX], 1)
+    grid.stress_gradient(C, ZF, PR[P_DZ], 0)
+    particles.gather_pass(P, S, W, n, C, XF, ZF, FLAGS, PR, step == 0)
+    particles.push_pass(P, S, W, n, C, FLAGS, h, PR)
+    particles.exchange_pass(P, S, W, n, C, XF, ZF, FLAGS, XD, ZD, BS, blocks, private, PR, ST, step)
+    grid.finish_faces(C, XF, XD, copies, substeps, step == 0, PR, 1)
+    grid.finish_faces(C, ZF, ZD, copies, substeps, step == 0, PR, 0)
+    block_sum(BS, 1, blocks, ST, ST_OUTFLOW)
+
+
+@ti.kernel
+def moments(P: F2, S: I2, C: F3, FLAGS: I2, CD: F4, BS: F2, PR: F1, ST: F1, n: ti.i32, blocks: ti.i32,
+            copies: ti.i32, private: ti.template()):
+    """The cell moments and fields of the parcels as they are (scatter, Eq. 38), the solid volume in the domain
+    (ST[ST_VOLUME]) and the largest parcel speed (ST[ST_SPEED])."""
+    grid.zero_copies(CD, copies)
+    particles.scatter_pass(P, S, n, C, FLAGS, CD, BS, blocks, private, PR)
+    grid.finish_cells(C, CD, copies, PR)
+    grid.flags_pass(C, FLAGS, PR)
+    ST[ST_VOLUME] = 0.0
+    block_sum(BS, 0, blocks, ST, ST_VOLUME)
+    max_speed(P, S, n, ST)
+
+
+@ti.kernel
+def append(P: F2, S: I2, n: ti.i32, values: F2, ints: I2):
+    """New parcels (values, ints: NUMPY) at columns n, n + 1, ..."""
+    store.append(P, S, n, values, ints)
+
+
+@ti.kernel
+def copy_parcels(P: F2, S: I2, P2: F2, S2: I2, n: ti.i32):
+    """The first n parcels into another buffer (a larger one when the capacity grows)."""
+    store.copy_parcels(P, S, P2, S2, n)
+
+
+@ti.kernel
+def read_parcels(P: F2, S: I2, values: F2, ints: I2):
+    """The first values.shape[1] parcels into the host's arrays (values, ints: NUMPY)."""
+    for j, p in values:
+        values[j, p] = P[j, p]
+    for j, p in ints:
+        ints[j, p] = S[j, p]
+
+
+@ti.kernel
+def read_stats(ST: F1, stats: F1):
+    """The reports into the host's copy (stats: NUMPY)."""
+    for j in ST:
+        stats[j] = ST[j]
+
+
+@ti.kernel
+def read_faces(XF: F3, ZF: F3, ST: F1, xfaces: F3, zfaces: F3, stats: F1):
+    """The face arrays and the reports into the host's copies (xfaces, zfaces, stats: NUMPY)."""
+    for I in ti.grouped(XF):
+        xfaces[I] = XF[I]
+    for I in ti.grouped(ZF):
+        zfaces[I] = ZF[I]
+    for j in ST:
+        stats[j] = ST[j]
+
+
+@ti.kernel
+def read_cells(C: F3, ST: F1, cells: F3, stats: F1):
+    """The cell arrays and the reports into the host's copies (cells, stats: NUMPY)."""
+    for I in ti.grouped(C):
+        cells[I] = C[I]
+    for j in ST:
+        stats[j] = ST[j]

@@ -1,0 +1,248 @@
+"""Taichi functions shared by the particle passes: bilinear stencils (Eq. 36-37), per-cell fast-path flags,
+the wall and packing rules of a parcel's move, and the run-local deposit into grid copies.
+
+Grids are the engine's channelled arrays (kernels.layout): ``G[channel, k, i]``; a parcel's position enters
+as cell coordinates s = (x - x0) / dx (the expression of hfgpu.proppant.interpolation.weights).
+The NumPy references are in hfgpu.proppant.interpolation and hfgpu.proppant.particle_ops_numpy.
+"""
+
+from hfgpu.kernels.layout import CELL, THETA, WIDTH
+from hfgpu.kernels.runtime import ti
+
+CHUNK = 64  # parcels per block of the atomic (GPU) deposits
+NO_RUN = -2  # stencil base of "no run yet": bilinear bases are >= -1 for points inside the grid (a parcel in
+#            the upper-left quarter of the first cell has base (-1, -1))
+INTERIOR = 1  # stencil_flags: the cell and its 8 neighbours lie in the grid and are open
+QUIET = 2  # ... and none of them has theta_p >= theta_cp
+LOOSE = 4  # ... and the cell and the one below it (+z) have theta_p < friction_volume_fraction
+
+
+@ti.func
+def bilinear(sx: ti.f64, sz: ti.f64, grid: ti.template(), mask: ti.template(), interior: ti.template()):
+    """Renormalised bilinear weights (Eq. 36-37) onto the active 2 x 2 nodes of channel ``mask`` of ``grid``
+    at node coordinates (sx, sz); see proppant/interpolation.py. ``interior``: the parcel's cell is INTERIOR
+    (stencil_flags), so all 4 nodes are in the grid and active and the plain weights (summing to 1 up to
+    round-off) are used. Returns the stencil base (k0, i0) and the 4 weights."""
+    fi = ti.floor(sx)
+    fk = ti.floor(sz)
+    fx = sx - fi
+    fz = sz - fk
+    i0 = ti.cast(fi, ti.i32)
+    k0 = ti.cast(fk, ti.i32)
+    w = ti.Vector([(1 - fz) * (1 - fx), (1 - fz) * fx, fz * (1 - fx), fz * fx], dt=ti.f64)
+    if ti.static(not interior):
+        nz = grid.shape[1]
+        nx = grid.shape[2]
+        for a in ti.static(range(2)):
+            for b in ti.static(range(2)):
+                kk = k0 + a
+                ii = i0 + b
+                if kk >= 0 and kk < nz and ii >= 0 and ii < nx:
+                    w[2 * a + b] = w[2 * a + b] * grid[mask, kk, ii]
+                else:
+                    w[2 * a + b] = 0.0
+        total = w[0] + w[1] + w[2] + w[3]
+        if total > 0.0:
+            w = w / total
+        else:
+            w = ti.Vector([0.0, 0.0, 0.0, 0.0], dt=ti.f64)
+    return k0, i0, w
+
+
+@ti.func
+def sample(grid: ti.template(), channel: ti.template(), k0: ti.i32, i0: ti.i32, w, interior: ti.template()):
+    """Sum of node values x weights (Eq. 40-41) of ``grid[channel]`` over the stencil at base (k0, i0);
+    outside INTERIOR cells nodes of weight 0 (possibly outside the grid) are not read."""
+    s = 0.0
+    for a in ti.static(range(2)):
+        for b in ti.static(range(2)):
+            if ti.static(interior):
+                s += grid[channel, k0 + a, i0 + b] * w[2 * a + b]
+            elif w[2 * a + b] > 0.0:
+                s += grid[channel, k0 + a, i0 + b] * w[2 * a + b]
+    return s
+
+
+@ti.func
+def cell_flags(k: ti.i32, i: ti.i32, cells: ti.template(), theta_cp: ti.f64, dense: ti.f64) -> ti.i32:
+    """stencil_flags of cell (k, i): INTERIOR, QUIET and LOOSE (see the constants; the last two only with
+    INTERIOR). A parcel owned by an INTERIOR cell has all its stencil nodes active (bilinear's plain weights);
+    one owned by a QUIET cell that stays in it is not stopped by any rule of blocked(); one owned by a LOOSE
+    cell is not on a bed (on_bed)."""
+    nz = cells.shape[1]
+    nx = cells.shape[2]
+    f = 0
+    if k >= 1 and k < nz - 1 and i >= 1 and i < nx - 1:
+        f = INTERIOR | QUIET
+        for a in ti.static(range(3)):
+            for b in ti.static(range(3)):
+                if cells[WIDTH, k + a - 1, i + b - 1] <= 0.0:
+                    f = 0
+                elif cells[THETA, k + a - 1, i + b - 1] >= theta_cp:
+                    f = f & ~QUIET
+        if f != 0 and cells[THETA, k, i] < dense and cells[THETA, k + 1, i] < dense:
+            f = f | LOOSE
+    return f
+
+
+@ti.func
+def deposit_weights(sx: ti.f64, sz: ti.f64, ox: ti.template(), oz: ti.template(), grid: ti.template(),
+                    mask: ti.template(), flag: ti.i32):
+    """bilinear at (sx + ox, sz + oz) onto channel ``mask`` of ``grid`` for a parcel at cell coordinates
+    (sx, sz) whose cell has the stencil_flags ``flag`` (owner_flags): plain weights where it is INTERIOR."""
+    k0 = ti.cast(0, ti.i32)
+    i0 = ti.cast(0, ti.i32)
+    w = ti.Vector.zero(ti.f64, 4)
+    if flag & INTERIOR:
+        k0, i0, w = bilinear(sx + ox, sz + oz, grid, mask, True)
+    else:
+        k0, i0, w = bilinear(sx + ox, sz + oz, grid, mask, False)
+    return k0, i0, w
+
+
+@ti.func
+def owner(sx: ti.f64, sz: ti.f64):
+    """(k, i) of the cell containing the point of cell coordinates (sx, sz) (possibly outside the grid)."""
+    return ti.cast(ti.floor(sz + 0.5), ti.i32), ti.cast(ti.floor(sx + 0.5), ti.i32)
+
+
+@ti.func
+def owner_flags(sx: ti.f64, sz: ti.f64, flags: ti.template()) -> ti.i32:
+    """stencil_flags of the cell containing the point of cell coordinates (sx, sz); 0 outside the grid."""
+    k, i = owner(sx, sz)
+    f = 0
+    if k >= 0 and k < flags.shape[0] and i >= 0 and i < flags.shape[1]:
+        f = flags[k, i]
+    return f
+
+
+@ti.func
+def owner_width(sx: ti.f64, sz: ti.f64, cells: ti.template()) -> ti.f64:
+    """Width of the cell containing the point of cell coordinates (sx, sz); 0 outside the grid."""
+    k, i = owner(sx, sz)
+    w = 0.0
+    if k >= 0 and k < cells.shape[1] and i >= 0 and i < cells.shape[2]:
+        w = cells[WIDTH, k, i]
+    return w
+
+
+@ti.func
+def closed(k: ti.i32, i: ti.i32, cells: ti.template()) -> ti.i32:
+    """Cell (k, i) is outside the grid or closed."""
+    out = 1
+    if k >= 0 and k < cells.shape[1] and i >= 0 and i < cells.shape[2]:
+        out = ti.cast(cells[WIDTH, k, i] <= 0.0, ti.i32)
+    return out
+
+
+@ti.func
+def blocked(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.template(), theta_cp: ti.f64,
+            dense: ti.f64) -> ti.i32:
+    """The move (sx, sz) -> (sxn, szn) (cell coordinates) leaves the grid, enters a closed cell, raises the
+    parcel's bilinear weight on a cell with theta_p >= theta_cp, or heads for a wall from a cell with theta_p >=
+    dense (friction_volume_fraction; particle_ops_numpy._blocked)."""
+    out = 1
+    if owner_width(sxn, szn, cells) > 0.0:
+        out = 0
+        if packed_near(sxn, szn, cells, theta_cp):
+            out = packed_gain(sx, sz, sxn, szn, cells, theta_cp)
+        if out == 0:
+            out = toward_wall_dense(sx, sz, sxn, szn, cells, dense)
+    return out
+
+
+@ti.func
+def toward_wall_dense(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.template(),
+                      dense: ti.f64) -> ti.i32:
+    """The parcel's own cell has theta_p >= dense and it moves, within the half cell next to a wall (domain
+    edge or closed cell), towards that wall (particle_ops_numpy._toward_wall_dense). The sign of the move is
+    that of sxn - sx: cell coordinates are monotone in x, and differ wherever the move counts."""
+    out = 0
+    k, i = owner(sx, sz)
+    if k >= 0 and k < cells.shape[1] and i >= 0 and i < cells.shape[2]:
+        if cells[THETA, k, i] >= dense:
+            fx = sx - i
+            fz = sz - k
+            if ti.abs(sxn - i) > ti.abs(fx) and fx * (sxn - sx) > 0.0:
+                out = closed(k, i + (1 if fx >= 0.0 else -1), cells)
+            if ti.abs(szn - k) > ti.abs(fz) and fz * (szn - sz) > 0.0:
+                out = out | closed(k + (1 if fz >= 0.0 else -1), i, cells)
+    return out
+
+
+@ti.func
+def packed_near(sx: ti.f64, sz: ti.f64, cells: ti.template(), theta_cp: ti.f64) -> ti.i32:
+    """Whether a cell of the 2 x 2 cell stencil of (sx, sz) has theta_p >= theta_cp (fast path of blocked)."""
+    i0 = ti.cast(ti.floor(sx), ti.i32)
+    k0 = ti.cast(ti.floor(sz), ti.i32)
+    found = 0
+    for a in ti.static(range(2)):
+        for b in ti.static(range(2)):
+            if k0 + a >= 0 and k0 + a < cells.shape[1] and i0 + b >= 0 and i0 + b < cells.shape[2]:
+                if cells[THETA, k0 + a, i0 + b] >= theta_cp:
+                    found = 1
+    return found
+
+
+@ti.func
+def packed_gain(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.template(), theta_cp: ti.f64) -> ti.i32:
+    """Whether the move raises the parcel's bilinear weight on a cell with theta_p >= theta_cp."""
+    out = 0
+    k0, i0, w0 = bilinear(sx, sz, cells, CELL, False)
+    k1, i1, w1 = bilinear(sxn, szn, cells, CELL, False)
+    for a in ti.static(range(2)):
+        for b in ti.static(range(2)):
+            if w1[2 * a + b] > 0.0:
+                if cells[THETA, k1 + a, i1 + b] >= theta_cp:
+                    before = 0.0
+                    for c in ti.static(range(2)):
+                        for d in ti.static(range(2)):
+                            if k0 + c == k1 + a and i0 + d == i1 + b:
+                                before += w0[2 * c + d]
+                    if w1[2 * a + b] > before:
+                        out = 1
+    return out
+
+
+@ti.func
+def flush(out: ti.template(), copy: ti.i32, k0: ti.i32, i0: ti.i32, acc: ti.template(), nch: ti.template(),
+          private: ti.template()):
+    """Add the locally summed 2 x 2 x nch block acc onto out[copy] (copies, nz, nx, channels) at base (k0, i0):
+    plainly where the copy is private to this task, else with atomics; nothing at base NO_RUN (no run yet);
+    blocks that sum to exactly 0 (every node outside the grid or inactive carries 0) are skipped."""
+    if k0 != NO_RUN:
+        for a in ti.static(range(2)):
+            for b in ti.static(range(2)):
+                for c in ti.static(range(nch)):
+                    if acc[2 * a + b, c] != 0.0:
+                        if ti.static(private):
+                            out[copy, k0 + a, i0 + b, c] = out[copy, k0 + a, i0 + b, c] + acc[2 * a + b, c]
+                        else:
+                            ti.atomic_add(out[copy, k0 + a, i0 + b, c], acc[2 * a + b, c])
+
+
+@ti.func
+def run_sum(out: ti.template(), copy: ti.i32, k0: ti.i32, i0: ti.i32, kb: ti.i32, ib: ti.i32, acc,
+            nch: ti.template(), private: ti.template()):
+    """Run-local summation of the deposits: when the next parcel's stencil base (k0, i0) differs from the
+    run's (kb, ib), flush the run's sums and start a new run at (k0, i0). Returns the run's (acc, kb, ib)."""
+    if k0 != kb or i0 != ib:
+        flush(out, copy, kb, ib, acc, nch, private)
+        acc = ti.Matrix.zero(ti.f64, 4, nch)
+        kb = k0
+        ib = i0
+    return acc, kb, ib
+
+
+@ti.func
+def block_range(block: ti.i32, blocks: ti.i32, n: ti.i32, private: ti.template()):
+    """Parcels [start, end) of a deposit block: ``blocks`` near-equal ranges (private copies) or CHUNK."""
+    start = ti.cast(0, ti.i32)
+    end = ti.cast(0, ti.i32)
+    if ti.static(private):
+        start = ti.cast(ti.cast(n, ti.i64) * block // blocks, ti.i32)
+        end = ti.cast(ti.cast(n, ti.i64) * (block + 1) // blocks, ti.i32)
+    else:
+        start = ti.cast(block * CHUNK, ti.i32)
+        end = ti.cast(ti.min(n, start + CHUNK), ti.i32)
+    return start, end
