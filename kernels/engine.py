@@ -9,8 +9,8 @@ the arguments typed NUMPY cross between host and device; everything else stays w
 """
 
 from hfgpu.kernels import grid, particles, store
-from hfgpu.kernels.layout import (GONE, NO_BAD, P_DX, P_DZ, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW,
-                                  ST_SPEED, ST_VOLUME, STATE, U, V)
+from hfgpu.kernels.layout import (MOMENT_COUNT, NO_BAD, P_DX, P_DZ, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW,
+                                  ST_SPEED, ST_VOLUME)
 from hfgpu.kernels.runtime import ti
 
 F1 = ti.types.ndarray(dtype=ti.f64, ndim=1)
@@ -30,12 +30,12 @@ def block_sum(BS: ti.template(), row: ti.template(), blocks: ti.i32, ST: ti.temp
 
 
 @ti.func
-def max_speed(P: ti.template(), S: ti.template(), n: ti.i32, ST: ti.template()):
-    """ST[ST_SPEED] = max |u| + |v| over the parcels not GONE (0 without any)."""
-    ST[ST_SPEED] = 0.0
-    for p in range(n):
-        if S[STATE, p] != GONE:
-            ti.atomic_max(ST[ST_SPEED], ti.abs(P[U, p]) + ti.abs(P[V, p]))
+def block_max(BS: ti.template(), row: ti.template(), blocks: ti.i32, ST: ti.template(), slot: ti.template()):
+    """ST[slot] = max(0, BS[row, 0], BS[row, 1], ...)."""
+    ST[slot] = 0.0
+    ti.loop_config(serialize=True)
+    for b in range(blocks):
+        ST[slot] = ti.max(ST[slot], BS[row, b])
 
 
 @ti.kernel
@@ -70,10 +70,9 @@ def substep(P: F2, S: I2, W: F2, C: F3, XF: F3, ZF: F3, FLAGS: I2, CD: F4, XD: F
         ST[ST_LEFT] = 0.0
         ST[ST_BAD_STEP] = NO_BAD
         ST[ST_BAD_PARCEL] = NO_BAD
-    ST[ST_SPEED] = 0.0
-    grid.zero_copies(CD, copies)
-    grid.zero_copies(XD, copies)
-    grid.zero_copies(ZD, copies)
+    grid.zero_copies(CD, copies, MOMENT_COUNT)
+    grid.zero_copies(XD, copies, 2)
+    grid.zero_copies(ZD, copies, 2)
     particles.scatter_pass(P, S, n, C, FLAGS, CD, BS, blocks, private, PR)
     grid.finish_cells(C, CD, copies, PR)
     grid.flags_pass(C, FLAGS, PR)
@@ -85,6 +84,7 @@ def substep(P: F2, S: I2, W: F2, C: F3, XF: F3, ZF: F3, FLAGS: I2, CD: F4, XD: F
     grid.finish_faces(C, XF, XD, copies, substeps, step == 0, PR, 1)
     grid.finish_faces(C, ZF, ZD, copies, substeps, step == 0, PR, 0)
     block_sum(BS, 1, blocks, ST, ST_OUTFLOW)
+    block_max(BS, 2, blocks, ST, ST_SPEED)
 
 
 @ti.kernel
@@ -92,13 +92,13 @@ def moments(P: F2, S: I2, C: F3, FLAGS: I2, CD: F4, BS: F2, PR: F1, ST: F1, n: t
             copies: ti.i32, private: ti.template()):
     """The cell moments and fields of the parcels as they are (scatter, Eq. 38), the solid volume in the domain
     (ST[ST_VOLUME]) and the largest parcel speed (ST[ST_SPEED])."""
-    grid.zero_copies(CD, copies)
+    grid.zero_copies(CD, copies, MOMENT_COUNT)
     particles.scatter_pass(P, S, n, C, FLAGS, CD, BS, blocks, private, PR)
     grid.finish_cells(C, CD, copies, PR)
     grid.flags_pass(C, FLAGS, PR)
     ST[ST_VOLUME] = 0.0
     block_sum(BS, 0, blocks, ST, ST_VOLUME)
-    max_speed(P, S, n, ST)
+    block_max(BS, 2, blocks, ST, ST_SPEED)
 
 
 @ti.kernel

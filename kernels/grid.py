@@ -94,10 +94,11 @@ def load_pressure(pressure: ti.template(), C: ti.template()):
 
 
 @ti.func
-def zero_copies(D: ti.template(), copies: ti.i32):
+def zero_copies(D: ti.template(), copies: ti.i32, channels: ti.template()):
     """Zero the first ``copies`` grid copies of a deposit array (copies, n1, n2, channels)."""
-    for c, k, i, j in ti.ndrange((0, copies), (0, D.shape[1]), (0, D.shape[2]), (0, D.shape[3])):
-        D[c, k, i, j] = 0.0
+    for c, k, i in ti.ndrange((0, copies), (0, D.shape[1]), (0, D.shape[2])):
+        for j in ti.static(range(channels)):
+            D[c, k, i, j] = 0.0
 
 
 @ti.func

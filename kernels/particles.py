@@ -28,11 +28,12 @@ varies from run to run); the engine keeps the parcels sorted by cell, so runs ar
 
 from hfgpu.kernels import elementary
 from hfgpu.kernels.layout import (
+    PARAM_COUNT,
     BRIDGED, CELL, DAMPING, DENSITY, DRAG, F_DP, F_DTAU, F_MASK, F_VELOCITY, GONE, LAG_X, LAG_Z, MEAN_U,
     MEAN_V, OUTLET, P_BED_FRICTION, P_BRIDGING, P_DAMPING_THRESHOLD, P_DRAG_ITERATIONS, P_DRAG_LAW, P_DX, P_DZ,
     P_EPSILON, P_FRICTION_FRACTION, P_GRAVITY, P_MU, P_PACKING_RESTITUTION, P_RE_COEFFICIENT, P_RHO_F, P_SHIELDS,
     P_THETA_CP, P_WALL_LAW, P_X0, P_Z0, PARTICLES, RADIUS, S_DAMPING, S_DPDX, S_DPDZ, S_DTDX, S_DTDZ, S_MEAN_U,
-    S_MEAN_V, S_THETA, S_UF, S_VF, S_WIDTH, SEEN, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_SPEED, STATE,
+    S_MEAN_V, S_THETA, S_UF, S_VF, S_WIDTH, SEEN, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, STATE,
     SUSPENDED, THETA, U, V, WIDTH, X, Z)
 from hfgpu.kernels.momentum import wall_friction_factor
 from hfgpu.kernels.runtime import ti
@@ -41,7 +42,15 @@ from hfgpu.kernels.stencil import (
     owner_flags, run_sum, sample)
 
 PI = 3.141592653589793
-LANES = 16  # parcels per gather and push task: the push's drag solves interleave (8: 1.2x slower)
+LANES = 8  # parcels per gather and push task: their drag solves interleave (measured at 1e6 parcels on 2 cores:
+#          the push 134 ms with 8, 150 ms with 16; 8 also halves the code to build and compile)
+
+
+@ti.func
+def constants(PR: ti.template()):
+    """The run constants PR as a vector of registers (a task reads them once: loads from PR inside a loop are
+    repeated after every store, which may alias them)."""
+    return ti.Vector([PR[j] for j in ti.static(range(PARAM_COUNT))], dt=ti.f64)
 
 
 @ti.func
@@ -63,7 +72,7 @@ def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template()
     """Bilinear sums of volume, mass, mass u, mass v, mass |u|^2, n r^3, n r^2 (Eq. 38) into CD (copies, nz, nx,
     7) (channel last: a node's sums share a cache line), which the caller zeroes and sums over copies; the
     solid volume of each block's parcels into BS[0, block] (the domain's solid volume, summed by the caller in
-    block order: the same on every run). Each block sums in registers while the stencil base stays the same."""
+    block order: the same on every run) and their largest |u| + |v| into BS[2, block]. Each block sums in registers while the stencil base stays the same."""
     for block in range(blocks):
         copy = block if ti.static(private) else 0
         start, end = block_range(block, blocks, n, private)
@@ -71,6 +80,7 @@ def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template()
         kb = NO_RUN
         ib = NO_RUN
         total = 0.0
+        fastest = 0.0
         for p in range(start, end):
             if S[STATE, p] != GONE:
                 sx, sz = cell_coordinates(P, p, PR)
@@ -85,11 +95,13 @@ def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template()
                 vals = ti.Vector([vol, mass, mass * u, mass * v, mass * (u ** 2 + v ** 2), n_p * r ** 3,
                                   n_p * r ** 2], dt=ti.f64)
                 total += vol
+                fastest = ti.max(fastest, ti.abs(u) + ti.abs(v))
                 for j in ti.static(range(4)):
                     for c in ti.static(range(7)):
                         acc[j, c] += vals[c] * w[j]
         flush(CD, copy, kb, ib, acc, 7, private)
         BS[0, block] = total
+        BS[2, block] = fastest
 
 
 @ti.func
@@ -334,18 +346,18 @@ def push_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i32, C
     in stack arrays (1.3x slower)."""
     for q in range(ti.cast((n + LANES - 1) // LANES, ti.i32)):
         p0 = ti.cast(q * LANES, ti.i32)
+        pr = constants(PR)
         s = ti.Matrix([[W[j, ti.min(p0 + l, n - 1)] for l in ti.static(range(LANES))]
                        for j in ti.static(range(SEEN))], dt=ti.f64)
-        un, vn, drag = velocity_lanes(p0, n, P, s, dt, PR)
-        for l in ti.static(range(LANES)):
+        un, vn, drag = velocity_lanes(p0, n, P, s, dt, pr)
+        for l in ti.static(range(LANES)):  # GONE parcels too: nothing reads them before the next sort drops them
             if p0 + l < n:
-                if S[STATE, p0 + l] != GONE:
-                    P[U, p0 + l] = un[l]
-                    P[V, p0 + l] = vn[l]
-                    W[DRAG, p0 + l] = drag[l]
+                P[U, p0 + l] = un[l]
+                P[V, p0 + l] = vn[l]
+                W[DRAG, p0 + l] = drag[l]
         for l in range(ti.cast(ti.min(LANES, n - p0), ti.i32)):
             if S[STATE, p0 + l] != GONE:
-                push_parcel(p0 + l, P, S, W, C, FLAGS, dt, PR)
+                push_parcel(p0 + l, P, S, W, C, FLAGS, dt, pr)
 
 
 @ti.func
@@ -364,8 +376,8 @@ def exchange_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i3
     DEPOSIT_FORCE, DEPOSIT_BETA (zeroed by the caller and summed over copies; blocks as in scatter_pass), with the
     parcels' new positions and velocities and the u_f, D_p of their push. Then per parcel: a non-finite state
     records the sub-step ``step`` and the parcel in ST; one in an outlet cell becomes GONE and its solid volume
-    goes into its block's outflow BS[1, block] (summed by the caller in block order); the others' |u| + |v|
-    goes into ST's maximum speed."""
+    goes into its block's outflow BS[1, block] (summed by the caller in block order); the others' largest
+    |u| + |v| into BS[2, block]."""
     nz = C.shape[1]
     nx = C.shape[2]
     for block in range(blocks):
@@ -378,6 +390,7 @@ def exchange_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i3
         kz = NO_RUN
         iz = NO_RUN
         outflow = 0.0
+        fastest = 0.0
         for p in range(start, end):
             if S[STATE, p] != GONE:
                 sx, sz = cell_coordinates(P, p, PR)
@@ -405,10 +418,11 @@ def exchange_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i3
                         outflow += vol
                         ti.atomic_add(ST[ST_LEFT], 1.0)
                     else:
-                        ti.atomic_max(ST[ST_SPEED], ti.abs(P[U, p]) + ti.abs(P[V, p]))
+                        fastest = ti.max(fastest, ti.abs(P[U, p]) + ti.abs(P[V, p]))
         flush(XD, copy, kx, ix, acc_x, 2, private)
         flush(ZD, copy, kz, iz, acc_z, 2, private)
         BS[1, block] = outflow
+        BS[2, block] = fastest
 
 
 __all__ = ["LANES", "scatter_pass", "gather_pass", "push_pass", "exchange_pass"]

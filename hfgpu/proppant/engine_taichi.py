@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import SimulationError
 from ..kernels import layout as L
 from .engine import SubLoop
 from .engine_numpy import bad_parcel
@@ -49,6 +48,7 @@ class TaichiEngine:
 
         self._ti, self._k = ti, ke
         self.private = self.arch == "cpu" if private is None else private
+        self.copies_limit = min(self.PRIVATE_COPIES, 2 * (self.threads or 1))
         self.params = params
         self.grid = grid
         self.outlets = np.ascontiguousarray(outlets, dtype=np.int32)
@@ -99,7 +99,7 @@ class TaichiEngine:
         self._work_rows = ti.ndarray(ti.f64, (L.WORK_ROWS, capacity))
         self._keys = ti.ndarray(ti.i64, (capacity,))
         blocks = max(self.PRIVATE_COPIES, -(-capacity // 64))
-        self._block_sums = ti.ndarray(ti.f64, (2, blocks))
+        self._block_sums = ti.ndarray(ti.f64, (3, blocks))
         self.capacity = capacity
 
     def _launch(self, kernel, *args) -> None:
@@ -118,7 +118,7 @@ class TaichiEngine:
             return max(1, -(-n // 64)), 1
         nz, nx = self.grid.shape
         fit = max(1, self.PRIVATE_BYTES // (8 * (nz + 1) * (nx + 1) * L.MOMENT_COUNT))
-        blocks = max(1, min(self.PRIVATE_COPIES, fit, n // self.PARCELS_PER_COPY))
+        blocks = max(1, min(self.copies_limit, fit, n // self.PARCELS_PER_COPY))
         return blocks, blocks
 
     def set_grid(self, grid: StaggeredGrid) -> None:

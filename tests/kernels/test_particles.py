@@ -155,7 +155,7 @@ def test_deposits_in_many_private_copies_match_numpy(private_bytes, blocks):
     frame, width, parcels, fluid = random_case(seed=3)
     params = MppicParams()
     engine = engine_for("taichi", frame, width, params)
-    engine.PARCELS_PER_COPY, engine.PRIVATE_BYTES = 200, private_bytes
+    engine.PARCELS_PER_COPY, engine.PRIVATE_BYTES, engine.copies_limit = 200, private_bytes, 16
     a, b = parcels.copy(), parcels.copy()
     la, _ = particle_step("taichi", frame, width, a, fluid, params)
     assert engine._blocks() == (blocks, blocks)
