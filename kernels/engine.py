@@ -9,9 +9,14 @@ the arguments typed NUMPY cross between host and device; everything else stays w
 """
 
 from hfgpu.kernels import grid, particles, store
-from hfgpu.kernels.layout import (MOMENT_COUNT, NO_BAD, P_DX, P_DZ, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW,
+from hfgpu.kernels.layout import (F_BETA, F_FORCE, M_MASS, M_VOLUME, MEAN_U, MEAN_V, MOMENT_COUNT, NO_BAD, SAUTER,
+                                  THETA, VARIANCE, P_DX, P_DZ, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW,
                                   ST_SPEED, ST_VOLUME)
 from hfgpu.kernels.runtime import ti
+
+#: what crosses to the host after a sub-loop and after a scatter, in this order
+FACE_OUT = (F_FORCE, F_BETA)
+CELL_OUT = (THETA, M_VOLUME, M_MASS, MEAN_U, MEAN_V, VARIANCE, SAUTER)
 
 F1 = ti.types.ndarray(dtype=ti.f64, ndim=1)
 F2 = ti.types.ndarray(dtype=ti.f64, ndim=2)
@@ -129,21 +134,27 @@ def read_stats(ST: F1, stats: F1):
         stats[j] = ST[j]
 
 
+@ti.func
+def read_channels(G: ti.template(), channels: ti.template(), out: ti.template()):
+    """out[j] = G[channels[j]] for each listed channel (a static tuple), over the grid of G."""
+    for k, i in ti.ndrange((0, G.shape[1]), (0, G.shape[2])):
+        for j in ti.static(range(len(channels))):
+            out[j, k, i] = G[channels[j], k, i]
+
+
 @ti.kernel
 def read_faces(XF: F3, ZF: F3, ST: F1, xfaces: F3, zfaces: F3, stats: F1):
-    """The face arrays and the reports into the host's copies (xfaces, zfaces, stats: NUMPY)."""
-    for I in ti.grouped(XF):
-        xfaces[I] = XF[I]
-    for I in ti.grouped(ZF):
-        zfaces[I] = ZF[I]
+    """The sub-loop's face means F and beta (FACE_OUT) and the reports into the host's copies (xfaces, zfaces,
+    stats: NUMPY)."""
+    read_channels(XF, FACE_OUT, xfaces)
+    read_channels(ZF, FACE_OUT, zfaces)
     for j in ST:
         stats[j] = ST[j]
 
 
 @ti.kernel
 def read_cells(C: F3, ST: F1, cells: F3, stats: F1):
-    """The cell arrays and the reports into the host's copies (cells, stats: NUMPY)."""
-    for I in ti.grouped(C):
-        cells[I] = C[I]
+    """The cell moments the host uses (CELL_OUT) and the reports into the host's copies (cells, stats: NUMPY)."""
+    read_channels(C, CELL_OUT, cells)
     for j in ST:
         stats[j] = ST[j]

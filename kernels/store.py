@@ -52,7 +52,7 @@ def counting_sort(P: ti.template(), S: ti.template(), P2: ti.template(), S2: ti.
     Algorithms, 8.2): histogram of the keys, exclusive prefix sum, scatter. ``stable``: the scatter runs in
     parcel order (serial; the CPU, where it keeps every run reproducible), else each parcel takes its slot with
     an atomic (a GPU: parallel, order within a half cell arbitrary)."""
-    buckets = (2 * nz + 2) * (2 * nx + 2) + 1
+    buckets = ti.cast((2 * nz + 2) * (2 * nx + 2) + 1, ti.i32)
     for b in range(buckets):
         counts[b] = 0
     for p in range(n):

@@ -66,9 +66,9 @@ class TaichiEngine:
         self._zd = ti.ndarray(f64, (copies, nz + 1, nx, 2))
         self._params = ti.ndarray(f64, (L.PARAM_COUNT,))
         self._params.from_numpy(param_vector(params, grid, fluid_density, fluid_viscosity, gravity))
-        self.host_cells = np.zeros((L.CELL_CHANNELS, nz, nx))
-        self.host_xf = np.zeros((L.FACE_CHANNELS, nz, nx + 1))
-        self.host_zf = np.zeros((L.FACE_CHANNELS, nz + 1, nx))
+        self.host_cells = np.zeros((len(ke.CELL_OUT), nz, nx))  # the channels of CELL_OUT, FACE_OUT
+        self.host_xf = np.zeros((len(ke.FACE_OUT), nz, nx + 1))
+        self.host_zf = np.zeros((len(ke.FACE_OUT), nz + 1, nx))
         self.host_stats = np.zeros(L.STAT_COUNT)
         self.launches = 0  # kernel launches so far
         self.transfers = 0  # host arrays handed to kernels so far (each crosses to and from a GPU)
@@ -200,8 +200,8 @@ class TaichiEngine:
             j = int(st[L.ST_BAD_PARCEL])
             parcel = self.parcels_at(j)
             raise bad_parcel(j, parcel[L.X], parcel[L.Z], self.grid.frame, t0 + (st[L.ST_BAD_STEP] + 1) * h)
-        return SubLoop(self.host_xf[L.F_FORCE].copy(), self.host_zf[L.F_FORCE].copy(),
-                       self.host_xf[L.F_BETA].copy(), self.host_zf[L.F_BETA].copy(), float(st[L.ST_OUTFLOW]))
+        (fx, bx), (fz, bz) = self.host_xf.copy(), self.host_zf.copy()
+        return SubLoop(fx, fz, bx, bz, float(st[L.ST_OUTFLOW]))
 
     def parcels_at(self, j: int) -> np.ndarray:
         """The float rows of parcel j (an error message's cell)."""
@@ -223,10 +223,7 @@ class TaichiEngine:
     def moments(self) -> CellMoments:
         """Cell moments of the parcels (Eq. 38), host copies."""
         self._refresh()
-        c = self.host_cells
-        return CellMoments(volume_fraction=c[L.THETA].copy(), solid_volume=c[L.M_VOLUME].copy(),
-                           mass=c[L.M_MASS].copy(), mean_u=c[L.MEAN_U].copy(), mean_v=c[L.MEAN_V].copy(),
-                           velocity_variance=c[L.VARIANCE].copy(), sauter_radius=c[L.SAUTER].copy())
+        return CellMoments(*self.host_cells.copy())
 
     def max_speed(self) -> float:
         """max |u| + |v| over the parcels."""
