@@ -28,7 +28,8 @@ I2 = ti.types.ndarray(dtype=ti.i32, ndim=2)
 
 @ti.func
 def block_sum(BS: ti.template(), row: ti.template(), blocks: ti.i32, ST: ti.template(), slot: ti.template()):
-    """ST[slot] += BS[row, 0] + BS[row, 1] + ... in block order (serial: the same sum on every run)."""
+    """ST[slot] += BS[row, 0] + BS[row, 1] + ... in block order (serial: the same sum on every run; for the few
+    private blocks of the CPU; a GPU's many blocks reduce with atomics in their pass)."""
     ti.loop_config(serialize=True)
     for b in range(blocks):
         ST[slot] += BS[row, b]
@@ -78,18 +79,20 @@ def substep(P: F2, S: I2, W: F2, C: F3, XF: F3, ZF: F3, FLAGS: I2, CD: F4, XD: F
     grid.zero_copies(CD, copies, MOMENT_COUNT)
     grid.zero_copies(XD, copies, 2)
     grid.zero_copies(ZD, copies, 2)
-    particles.scatter_pass(P, S, n, C, FLAGS, CD, BS, blocks, private, PR)
+    particles.scatter_pass(P, S, n, C, FLAGS, CD, BS, blocks, private, PR, ST)
     grid.finish_cells(C, CD, copies, PR)
     grid.flags_pass(C, FLAGS, PR)
     grid.stress_gradient(C, XF, PR[P_DX], 1)
     grid.stress_gradient(C, ZF, PR[P_DZ], 0)
     particles.gather_pass(P, S, W, n, C, XF, ZF, FLAGS, PR, step == 0)
     particles.push_pass(P, S, W, n, C, FLAGS, h, PR)
+    ST[ST_SPEED] = 0.0
     particles.exchange_pass(P, S, W, n, C, XF, ZF, FLAGS, XD, ZD, BS, blocks, private, PR, ST, step)
     grid.finish_faces(C, XF, XD, copies, substeps, step == 0, PR, 1)
     grid.finish_faces(C, ZF, ZD, copies, substeps, step == 0, PR, 0)
-    block_sum(BS, 1, blocks, ST, ST_OUTFLOW)
-    block_max(BS, 2, blocks, ST, ST_SPEED)
+    if ti.static(private):
+        block_sum(BS, 1, blocks, ST, ST_OUTFLOW)
+        block_max(BS, 2, blocks, ST, ST_SPEED)
 
 
 @ti.kernel
@@ -97,13 +100,15 @@ def moments(P: F2, S: I2, C: F3, FLAGS: I2, CD: F4, BS: F2, PR: F1, ST: F1, n: t
             copies: ti.i32, private: ti.template()):
     """The cell moments and fields of the parcels as they are (scatter, Eq. 38), the solid volume in the domain
     (ST[ST_VOLUME]) and the largest parcel speed (ST[ST_SPEED])."""
+    ST[ST_VOLUME] = 0.0
+    ST[ST_SPEED] = 0.0
     grid.zero_copies(CD, copies, MOMENT_COUNT)
-    particles.scatter_pass(P, S, n, C, FLAGS, CD, BS, blocks, private, PR)
+    particles.scatter_pass(P, S, n, C, FLAGS, CD, BS, blocks, private, PR, ST)
     grid.finish_cells(C, CD, copies, PR)
     grid.flags_pass(C, FLAGS, PR)
-    ST[ST_VOLUME] = 0.0
-    block_sum(BS, 0, blocks, ST, ST_VOLUME)
-    block_max(BS, 2, blocks, ST, ST_SPEED)
+    if ti.static(private):
+        block_sum(BS, 0, blocks, ST, ST_VOLUME)
+        block_max(BS, 2, blocks, ST, ST_SPEED)
 
 
 @ti.kernel

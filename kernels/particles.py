@@ -33,7 +33,7 @@ from hfgpu.kernels.layout import (
     MEAN_V, OUTLET, P_BED_FRICTION, P_BRIDGING, P_DAMPING_THRESHOLD, P_DRAG_ITERATIONS, P_DRAG_LAW, P_DX, P_DZ,
     P_EPSILON, P_FRICTION_FRACTION, P_GRAVITY, P_MU, P_PACKING_RESTITUTION, P_RE_COEFFICIENT, P_RHO_F, P_SHIELDS,
     P_THETA_CP, P_WALL_LAW, P_X0, P_Z0, PARTICLES, RADIUS, S_DAMPING, S_DPDX, S_DPDZ, S_DTDX, S_DTDZ, S_MEAN_U,
-    S_MEAN_V, S_THETA, S_UF, S_VF, S_WIDTH, SEEN, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, STATE,
+    S_MEAN_V, S_THETA, S_UF, S_VF, S_WIDTH, SEEN, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW, ST_SPEED, ST_VOLUME, STATE,
     SUSPENDED, THETA, U, V, WIDTH, X, Z)
 from hfgpu.kernels.momentum import wall_friction_factor
 from hfgpu.kernels.runtime import ti
@@ -68,11 +68,13 @@ def cell_coordinates(P: ti.template(), p: ti.i32, PR: ti.template()):
 
 @ti.func
 def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template(), FLAGS: ti.template(),
-                 CD: ti.template(), BS: ti.template(), blocks: ti.i32, private: ti.template(), PR: ti.template()):
+                 CD: ti.template(), BS: ti.template(), blocks: ti.i32, private: ti.template(), PR: ti.template(),
+                 ST: ti.template()):
     """Bilinear sums of volume, mass, mass u, mass v, mass |u|^2, n r^3, n r^2 (Eq. 38) into CD (copies, nz, nx,
     7) (channel last: a node's sums share a cache line), which the caller zeroes and sums over copies; the
     solid volume of each block's parcels into BS[0, block] (the domain's solid volume, summed by the caller in
-    block order: the same on every run) and their largest |u| + |v| into BS[2, block]. Each block sums in registers while the stencil base stays the same."""
+    block order: the same on every run) and their largest |u| + |v| into BS[2, block]; with shared copies (a
+    GPU: many blocks) both go straight into ST[ST_VOLUME], ST[ST_SPEED] with atomics instead. Each block sums in registers while the stencil base stays the same."""
     for block in range(blocks):
         copy = block if ti.static(private) else 0
         start, end = block_range(block, blocks, n, private)
@@ -100,8 +102,12 @@ def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template()
                     for c in ti.static(range(7)):
                         acc[j, c] += vals[c] * w[j]
         flush(CD, copy, kb, ib, acc, 7, private)
-        BS[0, block] = total
-        BS[2, block] = fastest
+        if ti.static(private):
+            BS[0, block] = total
+            BS[2, block] = fastest
+        else:
+            ti.atomic_add(ST[ST_VOLUME], total)
+            ti.atomic_max(ST[ST_SPEED], fastest)
 
 
 @ti.func
@@ -377,7 +383,7 @@ def exchange_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i3
     parcels' new positions and velocities and the u_f, D_p of their push. Then per parcel: a non-finite state
     records the sub-step ``step`` and the parcel in ST; one in an outlet cell becomes GONE and its solid volume
     goes into its block's outflow BS[1, block] (summed by the caller in block order); the others' largest
-    |u| + |v| into BS[2, block]."""
+    |u| + |v| into BS[2, block] (with shared copies: into ST[ST_OUTFLOW], ST[ST_SPEED] with atomics)."""
     nz = C.shape[1]
     nx = C.shape[2]
     for block in range(blocks):
@@ -421,8 +427,12 @@ def exchange_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i3
                         fastest = ti.max(fastest, ti.abs(P[U, p]) + ti.abs(P[V, p]))
         flush(XD, copy, kx, ix, acc_x, 2, private)
         flush(ZD, copy, kz, iz, acc_z, 2, private)
-        BS[1, block] = outflow
-        BS[2, block] = fastest
+        if ti.static(private):
+            BS[1, block] = outflow
+            BS[2, block] = fastest
+        else:
+            ti.atomic_add(ST[ST_OUTFLOW], outflow)
+            ti.atomic_max(ST[ST_SPEED], fastest)
 
 
 __all__ = ["LANES", "scatter_pass", "gather_pass", "push_pass", "exchange_pass"]

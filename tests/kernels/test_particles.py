@@ -75,6 +75,8 @@ def test_taichi_matches_numpy(drag_law, theta_cp, shields, private):
     ma = ea.moments()
     lb, eb = particle_step("numpy", frame, width, b, fluid, params, substeps=2)
     mb = eb.moments()
+    assert ea.max_speed() == pytest.approx(eb.max_speed(), rel=1e-12)
+    assert ea.solid_volume() == pytest.approx(eb.solid_volume(), rel=1e-12)
     for name in ma.__dataclass_fields__:
         close(getattr(ma, name), getattr(mb, name))
     for name in ("force_x", "force_z", "beta_x", "beta_z"):
