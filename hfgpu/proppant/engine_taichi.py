@@ -31,7 +31,7 @@ class TaichiEngine:
     ``PRIVATE_COPIES`` parcel blocks sums into its own grid copy without atomics (at most ``PRIVATE_BYTES`` of
     copies in all, at least ``PARCELS_PER_COPY`` parcels a block), and the parcels are re-sorted with a stable
     (serial) scatter; on CUDA, blocks of CHUNK parcels add into one grid with atomics, and the sort's scatter is
-    parallel. ``private`` forces either deposit (tests run the GPU's on the CPU)."""
+    parallel. ``private`` forces either deposit (tests run the GPU's on the CPU), ``stable_sort`` either sort."""
 
     name = "taichi"
     PRIVATE_COPIES = 16
@@ -48,6 +48,7 @@ class TaichiEngine:
 
         self._ti, self._k = ti, ke
         self.private = self.arch == "cpu" if private is None else private
+        self.stable_sort = self.private  # the sort's scatter in parcel order (serial), else with atomics
         self.copies_limit = min(self.PRIVATE_COPIES, 2 * (self.threads or 1))
         self.params = params
         self.grid = grid
@@ -171,7 +172,7 @@ class TaichiEngine:
         check_fluid(self.grid.width, u, v, p)
         self._current = 1 - self._accepted
         self._launch(self._k.begin_step, *self._buffers[self._accepted], *self._buffers[self._current],
-                     self._keys, self._counts, self._accepted_n, self.private, as_f64(u), as_f64(v), as_f64(p),
+                     self._keys, self._counts, self._accepted_n, self.stable_sort, as_f64(u), as_f64(v), as_f64(p),
                      self._cells, self._xf, self._zf, self._params, self._stats)
         self._launch(self._k.read_stats, self._stats, self.host_stats)
         self.n = int(self.host_stats[L.ST_LIVE])

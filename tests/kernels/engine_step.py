@@ -27,6 +27,7 @@ def engine_for(name: str, frame: GridFrame, width: np.ndarray, params: MppicPara
             from hfgpu.proppant.engine_taichi import TaichiEngine
 
             engine = TaichiEngine(grid, params, RHO_F, MU, gravity, outlets, private=private)
+            engine.stable_sort = True  # the parcels' order as Parcels.sort_by_cell's (the GPU's deposits kept)
         else:
             engine = make_engine(name, grid, params, RHO_F, MU, gravity, outlets)
         _ENGINES.clear()

@@ -129,6 +129,7 @@ def test_device_sort_is_the_stable_sort_by_cell_and_drops_what_left(private):
     outlets = np.zeros(width.shape, dtype=bool)
     outlets[:, -1] = True
     engine = engine_for("taichi", frame, width, MppicParams(), outlets=outlets, private=private)
+    engine.stable_sort = private
     engine.set_parcels(parcels)
     engine.begin_step(fluid["u"], fluid["v"], fluid["pressure"])
     ordered = parcels.copy()
