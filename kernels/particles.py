@@ -33,8 +33,8 @@ from hfgpu.kernels.layout import (
     MEAN_V, OUTLET, P_BED_FRICTION, P_BRIDGING, P_DAMPING_THRESHOLD, P_DRAG_ITERATIONS, P_DRAG_LAW, P_DX, P_DZ,
     P_EPSILON, P_FRICTION_FRACTION, P_GRAVITY, P_MU, P_PACKING_RESTITUTION, P_RE_COEFFICIENT, P_RHO_F, P_SHIELDS,
     P_THETA_CP, P_WALL_LAW, P_X0, P_Z0, PARTICLES, RADIUS, S_DAMPING, S_DPDX, S_DPDZ, S_DTDX, S_DTDZ, S_MEAN_U,
-    S_MEAN_V, S_THETA, S_UF, S_VF, S_WIDTH, SEEN, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW, ST_SPEED, ST_VOLUME, STATE,
-    SUSPENDED, THETA, U, V, WIDTH, X, Z)
+    S_MEAN_V, S_THETA, S_UF, S_VF, S_WIDTH, SEEN, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW, ST_SPEED,
+    ST_VOLUME, STATE, SUSPENDED, THETA, U, V, WIDTH, X, Z)
 from hfgpu.kernels.momentum import wall_friction_factor
 from hfgpu.kernels.runtime import ti
 from hfgpu.kernels.stencil import (
@@ -74,7 +74,8 @@ def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template()
     7) (channel last: a node's sums share a cache line), which the caller zeroes and sums over copies; the
     solid volume of each block's parcels into BS[0, block] (the domain's solid volume, summed by the caller in
     block order: the same on every run) and their largest |u| + |v| into BS[2, block]; with shared copies (a
-    GPU: many blocks) both go straight into ST[ST_VOLUME], ST[ST_SPEED] with atomics instead. Each block sums in registers while the stencil base stays the same."""
+    GPU: many blocks) both go straight into ST[ST_VOLUME], ST[ST_SPEED] with atomics instead. Each block sums
+    in registers while the stencil base stays the same."""
     for block in range(blocks):
         copy = block if ti.static(private) else 0
         start, end = block_range(block, blocks, n, private)
