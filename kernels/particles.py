@@ -67,6 +67,20 @@ def cell_coordinates(P: ti.template(), p: ti.i32, PR: ti.template()):
 
 
 @ti.func
+def report_block(BS: ti.template(), ST: ti.template(), block: ti.i32, row: ti.template(), slot: ti.template(),
+                 total: ti.f64, fastest: ti.f64, private: ti.template()):
+    """A deposit block's sum ``total`` (of BS row ``row``, ST slot ``slot``) and largest parcel speed: into
+    BS[row, block] and BS[2, block] for the caller to reduce in block order (private copies: the CPU's few
+    blocks), or straight into ST[slot] and ST[ST_SPEED] with atomics (shared copies: a GPU's many blocks)."""
+    if ti.static(private):
+        BS[row, block] = total
+        BS[2, block] = fastest
+    else:
+        ti.atomic_add(ST[slot], total)
+        ti.atomic_max(ST[ST_SPEED], fastest)
+
+
+@ti.func
 def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template(), FLAGS: ti.template(),
                  CD: ti.template(), BS: ti.template(), blocks: ti.i32, private: ti.template(), PR: ti.template(),
                  ST: ti.template()):
@@ -103,12 +117,7 @@ def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template()
                     for c in ti.static(range(7)):
                         acc[j, c] += vals[c] * w[j]
         flush(CD, copy, kb, ib, acc, 7, private)
-        if ti.static(private):
-            BS[0, block] = total
-            BS[2, block] = fastest
-        else:
-            ti.atomic_add(ST[ST_VOLUME], total)
-            ti.atomic_max(ST[ST_SPEED], fastest)
+        report_block(BS, ST, block, 0, ST_VOLUME, total, fastest, private)
 
 
 @ti.func
@@ -428,12 +437,7 @@ def exchange_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i3
                         fastest = ti.max(fastest, ti.abs(P[U, p]) + ti.abs(P[V, p]))
         flush(XD, copy, kx, ix, acc_x, 2, private)
         flush(ZD, copy, kz, iz, acc_z, 2, private)
-        if ti.static(private):
-            BS[1, block] = outflow
-            BS[2, block] = fastest
-        else:
-            ti.atomic_add(ST[ST_OUTFLOW], outflow)
-            ti.atomic_max(ST[ST_SPEED], fastest)
+        report_block(BS, ST, block, 1, ST_OUTFLOW, outflow, fastest, private)
 
 
 __all__ = ["LANES", "scatter_pass", "gather_pass", "push_pass", "exchange_pass"]
