@@ -62,7 +62,7 @@ def exp(x):
     k = t - ROUNDER
     r = (xc - k * LN2_HI) - k * LN2_LO
     p = estrin(r, EXP_TAYLOR)
-    scale = ti.bit_cast((ti.bit_cast(t, ti.i64) - ROUNDER_BITS + 1023) << 52, ti.f64)
+    scale = ti.bit_cast((ti.bit_cast(t, ti.i64) - ti.i64(ROUNDER_BITS) + 1023) << 52, ti.f64)
     return p * scale
 
 
@@ -74,7 +74,7 @@ def log(x):
     xs = ti.select(small, x * TWO54, x)
     bits = ti.bit_cast(xs, ti.i64)
     e = ti.cast((bits >> 52) - 1023, ti.f64) - ti.select(small, 54.0, 0.0)
-    m = ti.bit_cast((bits & MANTISSA) | ONE_BITS, ti.f64)
+    m = ti.bit_cast((bits & ti.i64(MANTISSA)) | ti.i64(ONE_BITS), ti.f64)
     high = m > SQRT2
     m = ti.select(high, 0.5 * m, m)
     e = e + ti.select(high, 1.0, 0.0)

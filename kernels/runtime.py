@@ -49,7 +49,7 @@ def init(arch: str | None = None, kernel_profiler: bool = False, cpu_threads: in
                          "compute in float64, which Taichi's vulkan, metal and opengl backends lack)")
     threads = cpu_threads or int(os.environ.get("HFGPU_THREADS", "0") or 0) or None
     _lean_positions()
-    ti.init(arch=getattr(ti, name), default_fp=ti.f64, default_ip=ti.i64,
+    ti.init(arch=getattr(ti, name), default_fp=ti.f64, default_ip=ti.i32,
             log_level=ti.WARN, offline_cache=True, fast_math=False, kernel_profiler=kernel_profiler,
             **({} if threads is None else {"cpu_max_num_threads": threads}))
     _state["arch"] = "cuda" if ti.lang.impl.current_cfg().arch == ti.cuda else "cpu"
