@@ -1,16 +1,19 @@
 """The ``hfgpu`` command: run a scene, plot a results file, check a scene (docs/cli.md).
 
 Exit codes: 0 success; 2 bad input or a failed run (an :class:`HfgpuError`, one line on stderr, no
-traceback; argparse usage errors too); 130 interrupted.
+traceback; argparse usage errors too); 128 + the signal's number when interrupted: 130 Ctrl-C (SIGINT), 143
+SIGTERM, 129 SIGHUP (the results file then says "interrupted" and resumes with --resume).
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from pathlib import Path
 
 from .errors import HfgpuError
+from .interrupts import signal_number
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -27,6 +30,8 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--view", action="store_true", help="stream to a Rerun viewer (spawned)")
     run.add_argument("--connect", metavar="URL", help="stream to a Rerun viewer or gRPC proxy already running "
                      "at URL, e.g. rerun+http://127.0.0.1:9876/proxy")
+    run.add_argument("--viewer-required", action="store_true", help="stop before any work when the viewer of "
+                     "--view or --connect cannot be reached (default: run without it, saying so in one line)")
     run.add_argument("--no-progress", action="store_true", help="no progress bar and no summary table")
 
     plot = commands.add_parser("plot", help="write PNG figures from a results file")
@@ -42,7 +47,7 @@ def _run(args: argparse.Namespace) -> None:
     from .runner import run
 
     run(args.scene, args.out, progress=not args.no_progress, rrd=args.rrd, view=args.view,
-        connect=args.connect, resume=args.resume)
+        connect=args.connect, resume=args.resume, viewer_required=args.viewer_required)
 
 
 def _plot(args: argparse.Namespace) -> None:
@@ -73,9 +78,10 @@ def main(argv: list[str] | None = None) -> int:
     except HfgpuError as exc:  # one line, even where a scene value holds line breaks
         print(f"hfgpu {args.command}: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"hfgpu {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        number = signal_number(exc)
+        print(f"hfgpu {args.command}: interrupted ({signal.Signals(number).name})", file=sys.stderr)
+        return 128 + number
     return 0
 
 

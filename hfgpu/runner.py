@@ -12,10 +12,13 @@ from __future__ import annotations
 
 import importlib
 import math
+import signal
+import sys
 from pathlib import Path
 from typing import Any, Callable
 
 from .errors import HfgpuError
+from .interrupts import signal_number, stop_signals_interrupt
 from .limits import check_limits
 from .scene import Scene, load_scene
 
@@ -64,13 +67,17 @@ def simulator_for(scene: Scene) -> Callable[..., dict]:
 
 def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = True,
         rrd: str | Path | None = None, view: bool = False, connect: str | None = None,
-        resume: bool = False) -> dict[str, Any]:
+        resume: bool = False, viewer_required: bool = False) -> dict[str, Any]:
     """Run a scene and write the results file ``out``; return the run's summary.
 
     ``progress`` shows a bar over simulated time and prints the summary table; ``rrd`` saves a Rerun
     recording to that file; ``view`` streams to a spawned Rerun viewer, ``connect`` to a viewer or
-    gRPC proxy already running at that URL. On any error the results file
-    is closed with status "failed: <message>" (every completed snapshot kept) and the error re-raised.
+    gRPC proxy already running at that URL. A viewer that cannot be reached (no display for ``view``, nothing
+    listening at ``connect``) is found before any work: with ``viewer_required`` that is an :class:`HfgpuError`,
+    else the run goes on without it and one line on stderr says so. On any error the results file
+    is closed with status "failed: <message>" (every completed snapshot kept) and the error re-raised; Ctrl-C,
+    SIGTERM and SIGHUP close it with status "interrupted" (summary and checkpoint kept, resumable) and re-raise
+    the ``KeyboardInterrupt`` (:mod:`hfgpu.interrupts`).
     Checkpoints go into ``out`` every :func:`hfgpu.io.checkpoint.checkpoint_interval` of simulated time.
 
     ``resume``: continue the run in ``out`` from its last checkpoint (the scene must equal the one stored
@@ -81,6 +88,7 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     scene = scene_or_path if isinstance(scene_or_path, Scene) else load_scene(scene_or_path)
     check_limits(scene)
     simulate = simulator_for(scene)
+    view, connect = _reachable_viewers(view, connect, viewer_required)
     from .io.checkpoint import Checkpointer, checkpoint_interval
     from .io.progress import Progress, summary_table
     from .io.results import ResultsWriter
@@ -108,7 +116,12 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
         _carry_over(bar, kept)
     sinks.append(bar)
     try:
-        result = simulate(scene, FanOut(sinks), progress=bar, checkpoint=checkpoint, resume=state)
+        with stop_signals_interrupt():
+            result = simulate(scene, FanOut(sinks), progress=bar, checkpoint=checkpoint, resume=state)
+    except KeyboardInterrupt as exc:
+        _close_others(sinks[1:])
+        writer.close("interrupted", {**bar.stats(), "interrupted_by": signal.Signals(signal_number(exc)).name})
+        raise
     except BaseException as exc:
         _close_others(sinks[1:])
         message = str(exc) or type(exc).__name__
@@ -121,6 +134,24 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     if progress:
         print(summary_table(summary), flush=True)
     return summary
+
+
+def _reachable_viewers(view: bool, connect: str | None, required: bool) -> tuple[bool, str | None]:
+    """``view`` and ``connect`` less what cannot be reached (:func:`hfgpu.io.rerun_view.viewer_problem`, one
+    line on stderr each), or :class:`HfgpuError` when ``required``."""
+    if not view and connect is None:
+        return view, connect
+    from .io.rerun_view import viewer_problem
+
+    kept = []
+    for spawn, url in ((view, None), (False, connect)):
+        problem = viewer_problem(spawn, url) if spawn or url is not None else None
+        if problem and required:
+            raise HfgpuError(f"{problem}; the run needs its viewer (--viewer-required), so it did not start")
+        if problem:
+            print(f"hfgpu run: {problem}; running without it", file=sys.stderr, flush=True)
+        kept.append(problem is None)
+    return view and kept[0], connect if kept[1] else None
 
 
 def _reopen(scene: Scene, out: Path):

@@ -114,3 +114,35 @@ def test_usage_errors_exit_2(args):
 def test_plot_of_a_file_that_is_not_results(tmp_path):
     (tmp_path / "x.h5").write_bytes(b"not hdf5")
     assert "cannot open results file" in _one_clean_line(_cli("plot", tmp_path / "x.h5"))
+
+
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.parametrize("viewer", ["connect", "view"])
+def test_unreachable_viewer_is_found_before_the_run(viewer, tmp_path):
+    """Nothing listening at --connect, or --view without a display: the run goes on without the viewer and says
+    so in one line; with --viewer-required it stops before any work (exit 2, no results file)."""
+    from hfgpu import open_results
+
+    path = tmp_path / "good.toml"
+    path.write_text(SCENE.format(nu=0.15))
+    args = (["--connect", f"rerun+http://127.0.0.1:{_free_port()}/proxy"] if viewer == "connect" else ["--view"])
+    env = {k: v for k, v in ENV.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    command = [sys.executable, "-c", WITH_FAKE, "none"]
+    done = subprocess.run([*command, "run", str(path), "--out", str(tmp_path / "r.h5"), "--no-progress", *args],
+                          capture_output=True, text=True, env=env, timeout=120)
+    assert done.returncode == 0, done.stderr
+    line = done.stderr.strip().splitlines()
+    assert len(line) == 1 and line[0].endswith("; running without it"), done.stderr
+    assert ("nothing reachable at 127.0.0.1" if viewer == "connect" else "no display") in line[0]
+    assert open_results(tmp_path / "r.h5").status == "complete"
+    stopped = subprocess.run([*command, "run", str(path), "--out", str(tmp_path / "s.h5"), "--viewer-required",
+                              *args], capture_output=True, text=True, env=env, timeout=120)
+    assert "the run needs its viewer (--viewer-required)" in _one_clean_line(stopped)
+    assert not (tmp_path / "s.h5").exists()

@@ -15,8 +15,12 @@ y across it and z up, so depth d is drawn at z = -d)::
 
 from __future__ import annotations
 
+import os
+import socket
+import sys
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlsplit
 
 import numpy as np
 
@@ -54,6 +58,28 @@ def cell_quads(x: np.ndarray, z: np.ndarray, dx: float, dz: float) -> tuple[np.n
     base = 4 * np.arange(x.size)[:, None]
     triangles = np.concatenate([base + [0, 1, 2], base + [0, 2, 3]], axis=1).reshape(-1, 3)
     return vertices, triangles.astype(np.uint32)
+
+
+def viewer_problem(spawn: bool, connect: str | None, timeout: float = 2.0) -> str | None:
+    """Why the viewer a run asks for cannot be reached, found before any work; None when it can. ``spawn``
+    needs a display on Linux (DISPLAY or WAYLAND_DISPLAY); ``connect`` needs something listening at the URL's
+    host and port (one TCP connection attempt, ``timeout`` seconds)."""
+    if spawn and sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
+                                                            or os.environ.get("WAYLAND_DISPLAY")):
+        return "--view: no display (DISPLAY and WAYLAND_DISPLAY are unset) to show a Rerun viewer on"
+    if connect is not None:
+        url = urlsplit(connect.removeprefix("rerun+"))
+        try:
+            host, port = url.hostname, url.port
+        except ValueError as exc:
+            return f"--connect {connect!r}: {exc}"
+        if not host or not port:
+            return f"--connect {connect!r}: expected a URL such as rerun+http://127.0.0.1:9876/proxy"
+        try:
+            socket.create_connection((host, port), timeout=timeout).close()
+        except OSError as exc:
+            return f"--connect {connect}: nothing reachable at {host}:{port} ({exc.strerror or exc})"
+    return None
 
 
 class RerunRecorder:
@@ -136,6 +162,10 @@ class RerunRecorder:
             self._scalar(f"proppant/{name}", getattr(record, name))
 
     def close(self) -> None:
-        """Flush and end the recording (the .rrd file is complete afterwards)."""
-        self.rec.flush()
-        self.rec.disconnect()
+        """Flush and end the recording (the .rrd file is complete afterwards); a viewer gone since the start
+        costs one line on stderr, not the run."""
+        try:
+            self.rec.flush()
+            self.rec.disconnect()
+        except Exception as exc:  # a streamed viewer that went away: the results file is what matters
+            print(f"hfgpu: the Rerun recording could not be flushed ({exc})", file=sys.stderr)

@@ -15,8 +15,8 @@ Integrity: the file is open only while a snapshot is written, and every change i
 renamed over the file when complete (``_edit``: HDF5 is not crash-safe on its own). A snapshot is built under
 a temporary name (``_incomplete``) and moved to its final zero-padded name once complete; balance records are buffered and written with each snapshot (and at close). A run killed at
 any moment therefore leaves every completed snapshot readable; a leftover ``_incomplete`` group is
-ignored by the reader. ``status`` is "running" until :meth:`ResultsWriter.close` writes "complete" or
-"failed: <message>"; a file still saying "running" after its run ended was interrupted.
+ignored by the reader. ``status`` is "running" until :meth:`ResultsWriter.close` writes "complete",
+"interrupted" or "failed: <message>"; a file still saying "running" after its run ended was killed.
 
 Checkpoints (:meth:`ResultsWriter.write_checkpoint`, :mod:`hfgpu.io.checkpoint`) are built under
 ``_checkpoint_new``, marked complete, flushed, and only then swapped for ``/checkpoint``; a kill between the
@@ -359,7 +359,8 @@ class Snapshots(Sequence):
 class Results:
     """A results file, read back. Arrays come from the file when asked for.
 
-    status: "complete", "failed: <message>", or "running" (still being written, or interrupted).
+    status: "complete", "interrupted" (Ctrl-C, SIGTERM, SIGHUP), "failed: <message>", or "running" (still
+    being written, or killed).
     summary: the ``/summary`` attributes (empty until the run closed the file).
     fracture_balance / proppant_balance: dicts of 1-D arrays (empty dict when absent).
     checkpoint_time: simulated time [s] of the checkpoint the file holds (None when it holds none).

@@ -10,7 +10,6 @@ stop with a clear error before any work.
 from __future__ import annotations
 
 import math
-import os
 import signal
 import subprocess
 import sys
@@ -250,6 +249,39 @@ def test_killed_cli_run_keeps_its_snapshots_and_resumes(reference, tmp_path):
     _assert_same_results(reference["fracture"], path)
     again = subprocess.run(command + ["--resume"], cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert again.returncode == 0 and "already complete" in again.stdout
+
+
+@pytest.mark.parametrize("stop", ["SIGTERM", "SIGHUP"])
+def test_sigterm_and_sighup_end_the_run_as_interrupted_and_resumable(stop, reference, tmp_path):
+    """``hfgpu run`` sent SIGTERM (kill, a batch scheduler) or SIGHUP (terminal closed) once its file holds a
+    checkpoint ends as Ctrl-C does: exit 128 + the signal, one line, status "interrupted" with a summary, and
+    ``--resume`` ends it as the uninterrupted run."""
+    number = getattr(signal, stop)
+    scene = tmp_path / "scene.toml"
+    scene.write_text(FRACTURE.replace('checkpoint_every = "7 s"', 'checkpoint_every = "3 s"'))
+    path = tmp_path / "stopped.h5"
+    command = [sys.executable, "-m", "hfgpu.cli", "run", str(scene), "--out", str(path), "--no-progress"]
+    proc = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120.0
+    try:
+        while proc.poll() is None and time.monotonic() < deadline:
+            try:
+                if open_results(path).checkpoint_time is not None:
+                    break
+            except (HfgpuError, OSError, KeyError):
+                pass
+            time.sleep(0.01)
+    finally:
+        proc.send_signal(number)
+        _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 128 + number, stderr
+    assert stderr.strip().splitlines()[-1] == f"hfgpu run: interrupted ({stop})"
+    cut = open_results(path)
+    assert cut.status == "interrupted" and cut.summary["interrupted_by"] == stop
+    assert cut.checkpoint_time is not None
+    done = subprocess.run(command + ["--resume"], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    _assert_same_results(reference["fracture"], path)
 
 
 # -- the engines' state ---------------------------------------------------------------------------------
