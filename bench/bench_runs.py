@@ -1,7 +1,7 @@
 """Whole runs end to end, process start included: the Chun slot (30 s), the Davis column (600 s), the scaled
-field demo and a 16 000-parcel, 1 000 s settling box, each as ``hfgpu run SCENE`` in a fresh process.
+field demo and a 16 000-parcel, 1 000 s settling column, each as ``hfgpu run SCENE`` in a fresh process.
 
-    python bench/bench_runs.py [--cases slot davis demo box] [--checkout PATH] [--threads 2]
+    python bench/bench_runs.py [--cases slot davis demo column] [--checkout PATH] [--threads 2]
 
 ``--checkout PATH`` runs another checkout of hfgpu instead (its ``hfgpu`` package and ``kernels`` folder
 arranged under a folder on PYTHONPATH, e.g. an older commit for a comparison in one sitting; the scene files
@@ -23,7 +23,7 @@ import h5py
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = {"slot": ROOT / "hfgpu/scenes/chun2020_slot.toml", "davis": ROOT / "hfgpu/scenes/davis1982.toml",
-         "demo": ROOT / "hfgpu/scenes/five_layer_demo.toml", "box": ROOT / "bench/scenes/settling_box.toml"}
+         "demo": ROOT / "hfgpu/scenes/five_layer_demo.toml", "column": ROOT / "bench/scenes/settling_column.toml"}
 
 
 def run_case(scene: Path, checkout: str | None, threads: int | None) -> tuple[float, dict]:

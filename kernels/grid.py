@@ -131,7 +131,10 @@ def finish_cells(C: ti.template(), CD: ti.template(), copies: ti.i32, PR: ti.tem
         C[VARIANCE, k, i] = variance
         C[SAUTER, k, i] = sauter
         den = stress_denominator(theta, PR)
-        C[TAU, k, i] = PR[P_STRESS_P] * ti.pow(theta, PR[P_STRESS_BETA]) / den
+        tau = 0.0
+        if theta > 0.0:  # theta^beta is 0 at theta = 0 (beta > 0): an empty cell skips the power
+            tau = PR[P_STRESS_P] * ti.pow(theta, PR[P_STRESS_BETA]) / den
+        C[TAU, k, i] = tau
         rate = 0.0
         if PR[P_DAMPING] > 0.0 and theta > PR[P_DAMPING_THRESHOLD] * PR[P_THETA_CP] and sauter > 0.0:
             eta = 0.5 * (1.0 + PR[P_RESTITUTION])

@@ -29,7 +29,9 @@ MIN_CAPACITY = 1024
 class TaichiEngine:
     """See hfgpu.proppant.engine for the seam. Deposits (scatter, exchange): on the CPU each of up to
     ``PRIVATE_COPIES`` parcel blocks sums into its own grid copy without atomics (at most ``PRIVATE_BYTES`` of
-    copies in all, at least ``PARCELS_PER_COPY`` parcels a block), and the parcels are re-sorted with a stable
+    copies in all; a block has at least ``PARCELS_PER_COPY`` parcels and at least half as many parcels as the
+    grid has cells, since each copy costs a zeroing and a summing pass over the grid and each parcel about four
+    cells' worth of deposits), and the parcels are re-sorted with a stable
     (serial) scatter; on CUDA, blocks of CHUNK parcels add into one grid with atomics, and the sort's scatter is
     parallel. ``private`` forces either deposit (tests run the GPU's on the CPU), ``stable_sort`` either sort."""
 
@@ -119,7 +121,7 @@ class TaichiEngine:
             return max(1, -(-n // 64)), 1
         nz, nx = self.grid.shape
         fit = max(1, self.PRIVATE_BYTES // (8 * (nz + 1) * (nx + 1) * L.MOMENT_COUNT))
-        blocks = max(1, min(self.copies_limit, fit, n // self.PARCELS_PER_COPY))
+        blocks = max(1, min(self.copies_limit, fit, n // max(self.PARCELS_PER_COPY, nz * nx // 2)))
         return blocks, blocks
 
     def set_grid(self, grid: StaggeredGrid) -> None:
