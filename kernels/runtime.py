@@ -5,13 +5,20 @@ default) or "cuda". Every kernel computes in float64, which Taichi's Vulkan, Met
 offer, so those are refused. Where CUDA is asked for but no CUDA device is there, Taichi runs on the CPU, and
 :func:`init` returns the architecture that actually runs. CPU threads: ``cpu_threads``, else the environment
 variable ``HFGPU_THREADS``, else one per core. Tests run on the CPU backend.
+
+Taichi's banners ("[Taichi] version ..." at import, "[Taichi] Starting on arch=..." at init) are not printed:
+they would land inside a run's progress bar, and the results' summary names the arch that ran. Setting
+ENABLE_TAICHI_HEADER_PRINT=1 brings back the first.
 """
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 
-import taichi as ti
+os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "False")
+import taichi as ti  # noqa: E402 (after the banner setting)
 
 from hfgpu.proppant.config import ARCHES
 _state: dict[str, str] = {}
@@ -49,9 +56,10 @@ def init(arch: str | None = None, kernel_profiler: bool = False, cpu_threads: in
                          "compute in float64, which Taichi's vulkan, metal and opengl backends lack)")
     threads = cpu_threads or int(os.environ.get("HFGPU_THREADS", "0") or 0) or None
     _lean_positions()
-    ti.init(arch=getattr(ti, name), default_fp=ti.f64, default_ip=ti.i32,
-            log_level=ti.WARN, offline_cache=True, fast_math=False, kernel_profiler=kernel_profiler,
-            **({} if threads is None else {"cpu_max_num_threads": threads}))
+    with contextlib.redirect_stdout(io.StringIO()):  # Taichi prints "Starting on arch=..." there
+        ti.init(arch=getattr(ti, name), default_fp=ti.f64, default_ip=ti.i32,
+                log_level=ti.WARN, offline_cache=True, fast_math=False, kernel_profiler=kernel_profiler,
+                **({} if threads is None else {"cpu_max_num_threads": threads}))
     _state["arch"] = "cuda" if ti.lang.impl.current_cfg().arch == ti.cuda else "cpu"
     return _state["arch"]
 
