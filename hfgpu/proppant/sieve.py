@@ -38,7 +38,7 @@ def sieve_range(label: str) -> tuple[float, float]:
         try:
             coarse, fine = (int(p) for p in parts)
         except ValueError:
-            raise ValueError(f'expected a sieve class "A/B" (e.g. "30/50", "40/70") or "100 mesh"') from None
+            raise ValueError('expected a sieve class "A/B" (e.g. "30/50", "40/70") or "100 mesh"') from None
     for number in (coarse, fine):
         if number not in ASTM_E11_OPENINGS:
             raise ValueError(f"sieve No. {number} is not in the ASTM E11 table; known: "

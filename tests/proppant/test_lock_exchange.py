@@ -18,7 +18,6 @@ rho_f + beta dt, beta dt ~ 2e4 kg/m^3 at dt ~ 10 ms): Fr = 0.03, the front 2 cm 
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from hfgpu import load_scene
 from hfgpu.proppant.simulator import ProppantSimulation
