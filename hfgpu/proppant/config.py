@@ -31,6 +31,7 @@ import numpy as np
 
 from ..errors import SceneError
 from ..presets import BALANCED, PRESETS, Preset
+from ..closure.config import ClassClosure, parse_class_closure
 from ..scene_reader import Table
 from .sieve import DISTRIBUTIONS, SizeDistribution, make_distribution, sieve_range
 
@@ -84,13 +85,15 @@ class Geometry:
 
 @dataclass(frozen=True)
 class ProppantClass:
-    """One proppant: name, particle density [kg/m^3], size distribution, initial suspension fraction."""
+    """One proppant: name, particle density [kg/m^3], size distribution, initial suspension fraction, closure keys
+    (conductivity table, lab loading, factor: :class:`hfgpu.closure.config.ClassClosure`)."""
 
     name: str
     density: float
     size: SizeDistribution
     initial_volume_fraction: float = 0.0
     sieve: str | None = None
+    closure: ClassClosure = ClassClosure()
 
 
 @dataclass(frozen=True)
@@ -270,6 +273,7 @@ def _parse_classes(top: Table) -> tuple[ProppantClass, ...]:
             size=_parse_size(t),
             initial_volume_fraction=t.number("initial_volume_fraction", 0.0, minimum=0.0, maximum=0.6),
             sieve=t.data.get("size"),
+            closure=parse_class_closure(t),
         ))
         t.finish()
     total = sum(c.initial_volume_fraction for c in classes)

@@ -1,0 +1,67 @@
+"""``hfgpu export --format csv``: the closure map and the pressure history as plain CSV tables.
+
+``FILE`` (the map): one row per cell of the closure grid, columns ``x``, ``depth`` (cell centre),
+``propped`` (0/1), ``propped_width``, ``conductivity``, ``permeability``, ``closure_stress``,
+``sauter_diameter``; ``<stem>_pressure.csv`` beside it: one row per snapshot (the fracture's, or the proppant
+grid's for a proppant-only run), columns ``time``, ``pressure_injection`` (the cell nearest the injection
+point, NaN when the scene names none), ``pressure_mean`` and ``pressure_max`` (over the open cells). Each
+header names the unit, e.g. ``conductivity [md ft]``, in SI or field units.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..closure.display import in_units, unit_label
+from .export_common import injection_point
+
+MAP_COLUMNS = ("x", "depth", "propped", "propped_width", "conductivity", "permeability", "closure_stress",
+               "sauter_diameter")
+
+
+def _header(names: tuple[str, ...], system: str) -> str:
+    return ",".join(name if name == "propped" else f"{name} [{unit_label(name, system)}]" for name in names)
+
+
+def write_csv(results: Any, closure: Any, out: Path, system: str) -> list[Path]:
+    """Write the map to ``out`` and the pressure history to ``<stem>_pressure.csv``; return both paths."""
+    fields = closure.fields
+    nz, nx = fields["propped_width"].shape
+    x, z = closure.frame.centres(nz, nx)
+    grid_x, grid_z = np.meshgrid(x, z)
+    columns = {"x": grid_x, "depth": grid_z, **fields}
+    table = np.column_stack([np.ravel(columns[n]) if n == "propped" else np.ravel(in_units(n, columns[n], system))
+                             for n in MAP_COLUMNS])
+    np.savetxt(out, table, delimiter=",", header=_header(MAP_COLUMNS, system), comments="", fmt="%.10g")
+    pressure = out.with_name(out.stem + "_pressure.csv")
+    history = pressure_history(results)
+    table = np.column_stack([history[0]] + [in_units("pressure", column, system) for column in history[1:]])
+    unit = unit_label("pressure", system)
+    header = ",".join(["time [s]"] + [f"pressure_{n} [{unit}]" for n in ("injection", "mean", "max")])
+    np.savetxt(pressure, table.reshape(-1, 4), delimiter=",", header=header, comments="", fmt="%.10g")
+    return [out, pressure]
+
+
+def pressure_history(results: Any) -> tuple[np.ndarray, ...]:
+    """(time [s], pressure at the injection cell, mean and max pressure over the open cells [Pa]) per snapshot
+    of the fracture (or, without any, of the proppant grid)."""
+    snaps = results.fracture_snapshots if len(results.fracture_snapshots) else results.proppant_snapshots
+    point = injection_point(results)
+    rows = []
+    for snap in snaps:
+        pressure, width = (snap.pressure, snap.width) if hasattr(snap, "width") else (snap.grid["pressure"],
+                                                                                         snap.grid["width"])
+        open_cells = np.asarray(width) > 0.0
+        at_injection = np.nan
+        if point is not None:
+            f = snap.frame
+            i = int(np.clip(np.floor((point[0] - f.x0) / f.dx + 0.5), 0, pressure.shape[1] - 1))
+            k = int(np.clip(np.floor((point[1] - f.z0) / f.dz + 0.5), 0, pressure.shape[0] - 1))
+            at_injection = float(pressure[k, i])
+        values = pressure[open_cells]
+        rows.append((snap.time, at_injection, values.mean() if values.size else np.nan,
+                     values.max() if values.size else np.nan))
+    return tuple(np.array(rows, dtype=np.float64).reshape(-1, 4).T)
