@@ -1,0 +1,296 @@
+"""The sweep file: its keys, read and checked into a :class:`Sweep` (docs/ensembles.md).
+
+A sweep file is TOML: ``scene`` (the base scene, relative to the sweep file), ``members`` (sampled designs),
+``design`` ("latin-hypercube", "grid" or "random"), ``seed``, one ``[[vary]]`` table per varied scene key and an
+optional ``[metrics] names``. These key names are a contract for outside tools: extend them, never rename them.
+
+Each ``[[vary]]`` has ``key`` (a scene key path, ``rock.leakoff_coefficient``, ``rock.layers[0].min_stress``) and
+either ``values = [...]`` or ``distribution`` with its parameters: ``uniform`` and ``log-uniform`` (``low``,
+``high``), ``normal`` (``mean``, ``std``), ``triangular`` (``low``, ``mode``, ``high``). Each value is a plain
+number (SI) or a string with units, as in a scene; it is checked against the key's kind by putting it into the
+base scene and parsing that, so a wrong unit gets the scene's own message, under the sweep's key path
+(``vary[0].low``). Numbers are then held in SI (pint's base units, which are SI for every scene kind) and
+written into member scenes with the SI unit of the key's kind ("65000000.0 Pa") when they were given with
+units, as plain numbers otherwise. A key that takes text (``proppant[0].size = "40/70"``) can vary over
+``values`` of text, kept as written.
+
+Errors are :class:`SweepError`: one line naming the sweep key, the value found and what is allowed.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import MISSING, SceneError
+from ..scene import parse_scene
+from ..scene_reader import Table
+from ..units import SI_UNITS, registry
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib  # type: ignore[no-redef]
+
+DESIGNS = ("latin-hypercube", "grid", "random")
+#: The parameters each distribution needs, in the order its transform takes them (hfgpu.ensemble.design).
+DISTRIBUTIONS = {"uniform": ("low", "high"), "log-uniform": ("low", "high"), "normal": ("mean", "std"),
+                 "triangular": ("low", "mode", "high")}
+#: Metrics a sweep can ask for (hfgpu.ensemble.metrics says how each is computed); the default set is all.
+METRIC_NAMES = ("propped_area", "created_area", "propped_fraction", "fracture_height", "fracture_length",
+                "net_pressure_end", "efficiency", "screened_out")
+
+_STEP = re.compile(r"([A-Za-z_][A-Za-z0-9_-]*)(?:\[(\d+)\])?$")
+
+
+class SweepError(SceneError):
+    """A sweep file value is missing, malformed or out of range: like a :class:`SceneError`, but the message
+    says ``sweep key 'vary[0].low': got ...; allowed ...``."""
+
+    def __str__(self) -> str:
+        return "sweep" + super().__str__()[len("scene"):]
+
+
+@dataclass(frozen=True)
+class Vary:
+    """One varied scene key: ``values`` (SI numbers; integers and text as written) or a ``distribution``
+    with its ``params`` in SI (the order of DISTRIBUTIONS)."""
+
+    key: str
+    steps: tuple[tuple[str, int | None], ...]   # the key path split: ("rock", None), ("layers", 0), ...
+    unit: str = ""                               # the SI unit member values are written with ("" : bare)
+    distribution: str | None = None
+    params: tuple[float, ...] = ()
+    values: tuple[float | int | str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A checked sweep file: the base scene's parsed TOML, the design and what varies."""
+
+    path: Path
+    source: str                      # the sweep file's text
+    scene_path: Path
+    scene_data: dict[str, Any]       # the base scene's TOML, parsed (never modified)
+    design: str
+    members: int                     # for a grid: the number of combinations
+    seed: int
+    vary: tuple[Vary, ...]
+    metrics: tuple[str, ...]
+
+
+def load_sweep(path: str | Path) -> Sweep:
+    """Read and check a sweep file; raises :class:`SweepError` (a :class:`SceneError`) naming the key."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise SweepError("(file)", str(path), f"cannot read the sweep file: {exc.strerror}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SweepError("(file)", str(path)[:80], f"not valid TOML: {exc}") from None
+    return parse_sweep(data, path, text)
+
+
+def parse_sweep(data: dict, path: Path, source: str = "") -> Sweep:
+    """Check a parsed sweep file found at ``path`` (the base scene is relative to its folder)."""
+    try:
+        return _parse(Table(data, ""), path, source)
+    except SweepError:
+        raise
+    except SceneError as exc:  # the reader's own messages, said of the sweep file
+        raise SweepError(exc.path, exc.value, exc.allowed) from None
+
+
+def _parse(top: Table, path: Path, source: str) -> Sweep:
+    scene_path = path.parent / top.string("scene")
+    try:
+        scene_text = scene_path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise SweepError("scene", top.data["scene"], f"cannot read the scene file {scene_path}: "
+                         f"{exc.strerror}") from None
+    try:
+        scene_data = tomllib.loads(scene_text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SweepError("scene", top.data["scene"], f"the scene is not valid TOML: {exc}") from None
+    try:
+        parse_scene(copy.deepcopy(scene_data), scene_text)
+    except SceneError as exc:
+        raise SweepError("scene", top.data["scene"], f"the base scene is not valid: {exc}") from None
+    design = top.choice("design", DESIGNS, "latin-hypercube")
+    seed = top.integer("seed", 0, minimum=0)
+    vary = tuple(_parse_vary(t, scene_data) for t in top.tables("vary"))
+    if not vary:
+        raise SweepError("vary", top.data.get("vary", MISSING), "at least one [[vary]] table is required")
+    keys = [v.key for v in vary]
+    for i, key in enumerate(keys):
+        if key in keys[:i]:
+            raise SweepError(f"vary[{i}].key", key, f"each key may be varied once (also vary[{keys.index(key)}])")
+    if design == "grid":
+        for i, v in enumerate(vary):
+            if not v.values:
+                raise SweepError(f"vary[{i}].distribution", v.distribution, 'a "grid" design needs values = [...]')
+        if top.has("members"):
+            raise SweepError("members", top.raw("members"), 'allowed only for sampled designs; a "grid" has one '
+                             "member per combination of the values")
+        members = math.prod(len(v.values) for v in vary)
+    else:
+        members = top.integer("members", minimum=1)
+    metrics_table = top.table("metrics", {})
+    names = metrics_table.raw("names", list(METRIC_NAMES))
+    if not isinstance(names, list) or not names:
+        raise SweepError("metrics.names", names, "expected a non-empty list of metric names")
+    for i, name in enumerate(names):
+        if name not in METRIC_NAMES:
+            raise SweepError(f"metrics.names[{i}]", name, f"allowed: {', '.join(map(repr, METRIC_NAMES))}")
+    metrics_table.finish()
+    top.finish()
+    return Sweep(path=path, source=source, scene_path=scene_path, scene_data=scene_data, design=design,
+                 members=members, seed=seed, vary=vary, metrics=tuple(dict.fromkeys(names)))
+
+
+def _parse_vary(t: Table, scene_data: dict) -> Vary:
+    key = t.string("key")
+    steps = split_key(key, t.key_path("key"), scene_data)
+    if t.has("values"):
+        if t.has("distribution"):
+            raise SweepError(t.key_path("distribution"), t.raw("distribution"), "give either values or a "
+                             "distribution, not both")
+        raw = t.raw("values")
+        if not isinstance(raw, list) or not raw:
+            raise SweepError(t.key_path("values"), raw, "expected a non-empty list of values")
+        values = tuple(_value(t, f"values[{i}]", item, key, steps, scene_data) for i, item in enumerate(raw))
+        t.finish()
+        return Vary(key=key, steps=steps, unit=_unit(raw, values), values=values)
+    distribution = t.choice("distribution", tuple(DISTRIBUTIONS))
+    names = DISTRIBUTIONS[distribution]
+    params = []
+    for name in names:
+        raw = t.raw(name)
+        if name == "std":
+            params.append(_std(t, raw, t.raw("mean")))
+        else:
+            params.append(_value(t, name, raw, key, steps, scene_data))
+            if isinstance(params[-1], str):
+                raise SweepError(t.key_path(name), raw, "a distribution needs numbers; list text values as "
+                                 "values = [...]")
+    t.finish()
+    _check_params(t, distribution, dict(zip(names, params)))
+    return Vary(key=key, steps=steps, unit=_unit([t.data[n] for n in names], params), distribution=distribution,
+                params=tuple(float(p) for p in params))
+
+
+def _check_params(t: Table, distribution: str, p: dict[str, float]) -> None:
+    if distribution in ("uniform", "log-uniform", "triangular") and not p["low"] < p["high"]:
+        raise SweepError(t.key_path("high"), t.data["high"], f"allowed: > low ({p['low']:g} in SI)")
+    if distribution == "log-uniform" and p["low"] <= 0.0:
+        raise SweepError(t.key_path("low"), t.data["low"], "allowed: > 0 (a log-uniform range is positive)")
+    if distribution == "triangular" and not p["low"] <= p["mode"] <= p["high"]:
+        raise SweepError(t.key_path("mode"), t.data["mode"], f"allowed: between low and high "
+                         f"({p['low']:g} and {p['high']:g} in SI)")
+
+
+def split_key(key: str, where: str, scene_data: dict) -> tuple[tuple[str, int | None], ...]:
+    """``rock.layers[0].min_stress`` as ((rock, None), (layers, 0), (min_stress, None)), checked against the
+    base scene: every table on the way must exist there (the last name may be new: a scene default)."""
+    steps = []
+    node: Any = scene_data
+    parts = key.split(".")
+    for depth, part in enumerate(parts):
+        match = _STEP.match(part)
+        if match is None:
+            raise SweepError(where, key, "expected a scene key path such as 'rock.leakoff_coefficient' or "
+                             "'rock.layers[0].min_stress'")
+        name, index = match.group(1), match.group(2)
+        steps.append((name, None if index is None else int(index)))
+        last = depth == len(parts) - 1
+        if not isinstance(node, dict) or (name not in node and not (last and index is None)):
+            raise SweepError(where, key, f"the base scene has no '{'.'.join(parts[:depth + 1])}'")
+        node = node.get(name)
+        if index is not None:
+            if not isinstance(node, list) or int(index) >= len(node):
+                size = len(node) if isinstance(node, list) else 0
+                raise SweepError(where, key, f"index {index} is past the end of '{name}' in the base scene "
+                                 f"({size} {'entry' if size == 1 else 'entries'}, the first is [0])")
+            node = node[int(index)]
+    if isinstance(node, (dict, list)):
+        raise SweepError(where, key, "expected a key holding one value, not a table")
+    return tuple(steps)
+
+
+def with_value(scene_data: dict, steps: tuple[tuple[str, int | None], ...], value: Any) -> dict:
+    """A copy of the parsed scene with the value at the key path ``steps`` replaced (or added)."""
+    data = copy.deepcopy(scene_data)
+    node = data
+    for name, index in steps[:-1]:
+        node = node[name] if index is None else node[name][index]
+    name, index = steps[-1]
+    if index is None:
+        node[name] = value
+    else:
+        node[name][index] = value
+    return data
+
+
+def si_number(raw: Any) -> float:
+    """A plain number as it is (SI), a string with units in pint's base units (SI)."""
+    if isinstance(raw, (int, float)) and not isinstance(raw, bool):
+        return float(raw)
+    return float(registry().Quantity(raw.strip()).to_base_units().magnitude)
+
+
+def _unit(raw: list[Any], values) -> str:
+    """The SI unit (hfgpu.units.SI_UNITS) of the first value given with units ("" when none is: numbers, text)."""
+    ureg = registry()
+    for text, value in zip(raw, values):
+        if isinstance(text, str) and not isinstance(value, str):
+            dimension = ureg.Quantity(text.strip()).dimensionality
+            for unit in SI_UNITS.values():
+                if unit and ureg.Quantity(1.0, unit).dimensionality == dimension:
+                    return unit
+    return ""
+
+
+def _value(t: Table, name: str, raw: Any, key: str, steps, scene_data: dict) -> float | int | str:
+    """``raw`` checked as a value of the scene key (parsed in the base scene) and returned in SI; text that the
+    key takes as text (a sieve class, "40/70") is returned as it is."""
+    where = t.key_path(name)
+    if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
+        raise SweepError(where, raw, "expected a number (SI) or a string with units, e.g. \"65 MPa\"")
+    try:
+        parse_scene(with_value(scene_data, steps, raw))
+    except SceneError as exc:
+        if exc.path == key and exc.allowed.startswith("unknown key"):  # the key itself is wrong, not the value
+            raise SweepError(t.key_path("key"), key, exc.allowed) from None
+        raise SweepError(where, raw, exc.allowed if exc.path == key else str(exc)) from None
+    if not isinstance(raw, str):
+        return raw if type(raw) is int else float(raw)
+    try:
+        number = si_number(raw)
+        parse_scene(with_value(scene_data, steps, number))
+    except Exception:  # not a quantity (pint raises several types), or the key wants text: the text is the value
+        return raw
+    return number
+
+
+def _std(t: Table, raw: Any, mean: Any) -> float:
+    """A standard deviation: positive, in the units of ``mean`` (pint dimension checked)."""
+    where = t.key_path("std")
+    if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
+        raise SweepError(where, raw, "expected a number (SI) or a string with units, e.g. \"1 MPa\"")
+    try:
+        number = si_number(raw)
+        if isinstance(raw, str) and isinstance(mean, str):
+            ureg = registry()
+            if ureg.Quantity(raw.strip()).dimensionality != ureg.Quantity(mean.strip()).dimensionality:
+                raise ValueError(f"'{raw}' is not of the dimension of mean '{mean}'")
+    except Exception as exc:  # pint raises several unrelated types on bad text
+        raise SweepError(where, raw, f"expected a quantity in the units of mean ({exc})") from None
+    if not number > 0.0 or not math.isfinite(number):
+        raise SweepError(where, raw, "allowed: > 0 and finite")
+    return number
