@@ -13,6 +13,8 @@ depth z is positive downward.
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -52,12 +54,22 @@ class FractureSnapshot:
 
 @dataclass(frozen=True)
 class BalanceRecord:
-    """Fluid volume balance [m^3]: injected = stored + leaked (to the tolerance of the solver)."""
+    """One accepted fracture step: the fluid volume balance [m^3], injected = stored + leaked (to the tolerance
+    of the solver), and the pressure history a treatment is read by: the fluid pressure in the injection cell
+    [Pa], the net pressure there (that pressure minus the minimum stress at the injection depth) [Pa], the
+    fluid efficiency stored / injected, the footprint's area [m^2], length and height [m] (geometry.py). The
+    history fields are NaN where a record does not carry them (a results file written before they existed)."""
 
     time: float
     injected: float
     stored: float
     leaked: float
+    injection_pressure: float = math.nan
+    net_pressure: float = math.nan
+    efficiency: float = math.nan
+    area: float = math.nan
+    length: float = math.nan
+    height: float = math.nan
 
 
 @dataclass(frozen=True)
