@@ -132,16 +132,18 @@ def recommend(summary: dict[str, dict[str, Run]]) -> list[tuple[str, str, str]]:
         return sum(summary[p][c].cpu for c in cases if c in summary[p] and np.isfinite(summary[p][c].cpu))
 
     def describe(p):
-        parts = []
+        parts = {True: [], False: []}  # against an outside reference, against the most accurate run
         for c in cases:
             r = summary[p].get(c)
             if r is None or not np.isfinite(r.error):
-                parts.append(f"{c} {'failed' if r is not None and not r.values else '-'}")
+                text = f"{c} {'failed' if r is not None and not r.values else '-'}"
             elif r.note.startswith("reference"):
-                parts.append(f"{c} reference")
+                text = f"{c} reference"
             else:
-                parts.append(f"{c} {100 * r.error:.1f} %")
-        return f"errors {', '.join(parts)}; {cpu(p):.1f} CPU s over the cases"
+                text = f"{c} {100 * r.error:.1f} %"
+            parts[c in outside].append(text)
+        own = f"; against its most accurate run {', '.join(parts[False])}" if parts[False] else ""
+        return f"errors {', '.join(parts[True])}{own}; {cpu(p):.1f} CPU s over the cases"
 
     out = []
     names = list(PRESETS)  # fastest first
@@ -150,12 +152,13 @@ def recommend(summary: dict[str, dict[str, Run]]) -> list[tuple[str, str, str]]:
         if ok:
             p = ok[0]
             cheaper = [q for q in names[:names.index(p)]]
-            why = f"cheapest preset within {100 * bound:.0f} % on every case: {describe(p)}"
+            why = f"cheapest preset within {100 * bound:.0f} % on every case with an outside reference: {describe(p)}"
             if cheaper:
                 why += "; " + "; ".join(f"{q} is out ({describe(q)})" for q in cheaper)
         else:
             p = min(names, key=worst)
-            why = f"no preset is within {100 * bound:.0f} % on every case; {p} has the smallest worst error: {describe(p)}"
+            why = (f"no preset is within {100 * bound:.0f} % on every case with an outside reference; {p} has the "
+                   f"smallest worst error: {describe(p)}")
         out.append((use, p, why))
 
     def wins(p):
@@ -323,7 +326,7 @@ def write_report(runs: list[Run], meta: dict, out: Path) -> list[Path]:
           "elements + proppant grid cells (field); `parcels` = parcels at the end; `steps` = fracture steps + "
           "fluid steps; `error` as above (a failed run has none: its note says why).", "",
           "Presets (the values this study used are in the table below): those of `hfgpu/presets.py` when the "
-          "study ran (issue 5's table where that module is absent), applied through the knobs "
+          "study ran, applied through the knobs "
           "(`bench/_study_cases.py`). "
           "As in hfgpu, a key the case's scene file sets itself wins over the preset: davis1982.toml sets "
           "`parcels_per_cell = 16` and `dt_max = 2 s`, five_layer_demo.toml `parcels_per_cell = 8`; the sweeps "

@@ -1,8 +1,10 @@
 """Chun et al. (2020) slot demo (the paper's Fig. 9-10): proppant volume fraction snapshots, bed profiles at 5, 15
 and 20 s, and the bank length and area vs time against the experiment (when the GEOS-digitised data are given).
 
-    python demos/slot.py [--scene hfgpu/scenes/chun2020_slot.toml] [--end 30] [--out demo_output]
-                         [--data ../shared/validation-data/chun_2020_bank_length_area_geos.txt]
+    python demos/slot.py [--scene hfgpu/scenes/chun2020_slot.toml] [--end 30] [--out demo_output] [--data BANK.txt]
+
+BANK.txt: the experiment's bank length and area against time as digitised for GEOS (columns t [s], length / slot
+length, area / slot area); reference data that a clone of hfgpu does not hold (without them: the model only).
 """
 
 from __future__ import annotations
@@ -52,7 +54,7 @@ def main() -> None:
                        vmax=sim.params.theta_cp, cmap="YlOrBr", aspect="equal")
         ax.set_title(f"t = {snap.time:.0f} s", fontsize=9)
         ax.set_ylabel("depth [m]")
-        fig.colorbar(im, ax=ax, label=r"$\theta_p$")
+        fig.colorbar(im, ax=ax, label=r"$\theta_p$ (one scale, 0 to close packing)")
     axes[-1, 0].set_xlabel("x [m]")
     fig.tight_layout()
     fig.savefig(out / "slot_snapshots.png", dpi=150)
@@ -79,7 +81,8 @@ def main() -> None:
         ax.plot(data[:, 0], data[:, 1], "bs", mfc="none", label="length, Chun et al. (2020)")
         ax.plot(data[:, 0], data[:, 2], "rs", mfc="none", label="area, Chun et al. (2020)")
     ax.set_xlabel("time [s]")
-    ax.set_ylabel("normalised")
+    ax.set_ylabel("bank length / slot length,\nbank area / slot area [-]")
+    ax.set_title(f"bank: cells with theta_p >= {threshold:.2g} (half of close packing)", fontsize=9)
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(out / "slot_bank.png", dpi=150)

@@ -1,0 +1,241 @@
+"""What a run and ``hfgpu check`` print for a person: the run's summary as a short grouped table with units, and the
+pump schedule as a treatment report shows it, both in the output units (``[output] units``, "SI" or "field";
+docs/cli.md). The results file keeps every summary key in SI (``/summary``); these tables only choose and convert.
+
+Summary groups and rows (a row whose value the run did not produce is left out; a time that never came, such as a
+screen-out that did not happen, reads "never"):
+
+* fracture: created area, length (tip to tip), height, width at the perforation, net pressure at the end;
+* fluid: pumped, in the fracture, leaked off, fluid efficiency, fluid pressure at the perforation at the end;
+* proppant: pumped, in the fracture (in the domain, for a proppant-only run), held back at the inlet (screen-out) and when it began, left the domain, parcels,
+  and the closure results (propped area and its share of the created area, propped half-length and height, mean
+  conductivity, F_CD, at which time);
+* run: status, simulated time, wall time, fracture and proppant steps, volume balance error, proppant engine,
+  resumed from, results file.
+
+Proppant amounts are masses where every class has the same grain density, else solid volumes.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from ..closure.display import in_units as closure_in_units
+from ..closure.display import unit_label as closure_unit
+from ..units import display_unit, format_number, in_display_units
+
+#: The groups in the order they are printed.
+GROUPS = ("fracture", "fluid", "proppant", "run")
+
+
+def _first(summary: dict, *keys: str) -> Any:
+    """The value of the first of ``keys`` the summary holds (fracture-only and coupled runs name some differently)."""
+    for key in keys:
+        if key in summary:
+            return summary[key]
+    return None
+
+
+def _finite(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _quantity(value: Any, kind: str, system: str) -> str | None:
+    if not _finite(value):
+        return None
+    return f"{format_number(in_display_units(float(value), kind, system))} {display_unit(kind, system)}"
+
+
+def _percent(value: Any, digits: int = 3) -> str | None:
+    return f"{format_number(100.0 * value, digits)} %" if _finite(value) else None
+
+
+def _count(value: Any) -> str | None:
+    return f"{int(value)}" if _finite(value) else None
+
+
+def _when(value: Any) -> str:
+    return f"{format_number(float(value))} s" if _finite(value) else "never"
+
+
+def _proppant_amount(value: Any, density: float | None, system: str) -> str | None:
+    if not _finite(value):
+        return None
+    if density is not None:
+        return _quantity(value * density, "mass", system)
+    return _quantity(value, "solid_volume", system)
+
+
+def summary_rows(summary: dict[str, Any], system: str = "SI",
+                 density: float | None = None) -> list[tuple[str, str, str]]:
+    """(group, label, value with its unit) of the rows the table shows, in order; ``density`` [kg/m^3] is the
+    proppant's grain density when all classes share it (amounts then shown as masses)."""
+    s = summary
+    rows: list[tuple[str, str, str | None]] = []
+
+    def add(group: str, label: str, text: str | None) -> None:
+        rows.append((group, label, text))
+
+    area = _first(s, "area", "fracture_area")
+    add("fracture", "created area", _quantity(area, "area", system))
+    add("fracture", "length (tip to tip)", _quantity(_first(s, "length", "fracture_length"), "length", system))
+    add("fracture", "height", _quantity(_first(s, "height", "fracture_height"), "length", system))
+    add("fracture", "width at the perforation", _quantity(_first(s, "w_inlet", "fracture_w_inlet"), "width", system))
+    add("fracture", "net pressure at the end", _quantity(s.get("net_pressure_end"), "pressure", system))
+
+    add("fluid", "pumped", _quantity(s.get("injected_volume"), "volume", system))
+    add("fluid", "in the fracture", _quantity(s.get("stored_volume"), "volume", system))
+    add("fluid", "leaked off", _quantity(s.get("leaked_volume"), "volume", system))
+    add("fluid", "fluid efficiency", _percent(s.get("efficiency")))
+    add("fluid", "pressure at the perforation, end", _quantity(s.get("injection_pressure_end"), "pressure", system))
+
+    pumped = s.get("proppant_injected")
+    add("proppant", "pumped", _proppant_amount(pumped, density, system))
+    where = "in the fracture" if area is not None else "in the domain"   # a proppant-only run has a box or slot
+    add("proppant", where, _proppant_amount(s.get("proppant_in_domain"), density, system))
+    screened = _first(s, "proppant_screened_out", "screened_out")
+    if _finite(pumped) and _finite(screened):
+        held = _proppant_amount(screened, density, system)
+        if pumped > 0 and screened > 0:
+            held += f" ({format_number(100.0 * screened / pumped, 3)} % of pumped)"
+        add("proppant", "held back at the inlet", held)
+        add("proppant", "screen-out began", _when(_first(s, "proppant_screen_out_time", "screen_out_time")))
+    outflow = s.get("proppant_outflow")
+    if _finite(outflow) and outflow > 0:
+        add("proppant", "left the domain", _proppant_amount(outflow, density, system))
+    add("proppant", "parcels", _count(_first(s, "proppant_parcels", "parcels")))
+    if "closure_propped_area" in s:
+        propped = s["closure_propped_area"]
+        text = f"{format_number(closure_in_units('propped_area', propped, system))} {closure_unit('propped_area', system)}"
+        if _finite(area) and area > 0:
+            text += f" ({format_number(100.0 * propped / area, 3)} % of created)"
+        add("proppant", "propped area", text)
+        for name, label in (("propped_half_length", "propped half-length"), ("propped_height", "propped height"),
+                            ("mean_conductivity", "mean conductivity"), ("fcd", "F_CD")):
+            value = s.get(f"closure_{name}")
+            if _finite(value):
+                unit = closure_unit(name, system)
+                add("proppant", label, f"{format_number(closure_in_units(name, value, system))} {unit}".rstrip())
+        add("proppant", "closure at", _when(s.get("closure_time")))
+
+    add("run", "status", str(s["status"]) if "status" in s else None)
+    add("run", "simulated time", _quantity(s.get("sim_time"), "time", system))
+    add("run", "wall time", f"{format_number(s['wall_time'], 3)} s" if _finite(s.get("wall_time")) else None)
+    add("run", "fracture steps", _count(s.get("fracture_steps")))
+    add("run", "proppant steps", _count(s.get("proppant_steps")))
+    balance = s.get("balance_error")
+    add("run", "volume balance error", "< 0.01 %" if _finite(balance) and abs(balance) < 1e-4 else _percent(balance, 2))
+    backend = _first(s, "proppant_backend", "backend")
+    if backend is not None and "proppant_injected" in s:
+        arch = _first(s, "proppant_arch", "arch")
+        add("run", "proppant engine", f"{backend}" + (f" ({arch})" if arch else ""))
+    if _finite(s.get("resumed_from")):
+        add("run", "resumed from", _when(s["resumed_from"]))
+    add("run", "results file", str(s["out"]) if "out" in s else None)
+    return [(g, label, text) for g, label, text in rows if text is not None]
+
+
+def _table(rows: list[tuple[str, str, str]]) -> str:
+    width = max((len(label) for _, label, _ in rows), default=0)
+    lines, group = [], None
+    for g, label, text in rows:
+        if g != group:
+            lines.append(g)
+            group = g
+        lines.append(f"  {label:<{width}}  {text}")
+    return "\n".join(lines)
+
+
+def shared_density(scene: Any) -> float | None:
+    """The grain density [kg/m^3] all proppant classes of ``scene`` share, None if they differ (or no proppant)."""
+    if scene is None or getattr(scene, "proppant", None) is None:
+        return None
+    densities = set(scene.proppant.class_densities().values())
+    return densities.pop() if len(densities) == 1 else None
+
+
+def summary_table(summary: dict[str, Any], system: str = "SI", scene: Any = None) -> str:
+    """The run's summary as a grouped text table (fracture, fluid, proppant, run) in ``system``'s units."""
+    return _table(summary_rows(summary, system, shared_density(scene)))
+
+
+# ----------------------------------------------------------------------------------------------
+# the pump schedule
+
+
+def schedule_rows(scene: Any) -> list[dict[str, Any]]:
+    """One dict per stage of the scene's schedule, in SI: stage (1-based), kind ("pad", "slurry" or "shut-in"),
+    proppant, start, end [s], rate (slurry) [m^3/s], slurry and clean volume [m^3], solids volume [m^3], proppant
+    mass [kg] (None without a grain density), concentration at start and end [kg per m^3 of clean fluid]. Kinds:
+    "pad" (clean fluid before proppant), "slurry", "flush" (clean fluid after proppant), "fluid" (a schedule without
+    proppant), "shut-in" (rate 0).
+
+    Within a stage the slurry rate Q is constant and the slurry volume fraction phi linear in time, so the solids
+    volume is Q dt (phi_0 + phi_1) / 2 exactly, the clean volume Q dt less that, and the concentration
+    rho_p phi / (1 - phi)."""
+    densities = scene.proppant.class_densities() if getattr(scene, "proppant", None) is not None else {}
+    rows, start = [], 0.0
+    stages = scene.injection.schedule.stages
+    for i, stage in enumerate(stages):
+        slurry = stage.rate * (stage.until - start)
+        solids = slurry * 0.5 * (stage.volume_fraction + stage.end_volume_fraction)
+        density = densities.get(stage.proppant)
+        if stage.rate <= 0.0:
+            kind = "shut-in"
+        elif stage.proppant is not None:
+            kind = "slurry"
+        else:  # clean fluid: a pad before the proppant, a flush after it, plain fluid in a schedule without any
+            kind = "flush" if any(s.proppant for s in stages[:i]) else \
+                ("pad" if any(s.proppant for s in stages[i:]) else "fluid")
+        concentration = [density * phi / (1.0 - phi) if density is not None else None
+                         for phi in (stage.volume_fraction, stage.end_volume_fraction)]
+        rows.append(dict(stage=i + 1, kind=kind, proppant=stage.proppant, start=start, end=stage.until,
+                         rate=stage.rate, slurry_volume=slurry, clean_volume=slurry - solids, solid_volume=solids,
+                         mass=solids * density if density is not None else None,
+                         concentration_start=concentration[0], concentration_end=concentration[1]))
+        start = stage.until
+    return rows
+
+
+def schedule_table(scene: Any, system: str = "SI") -> str:
+    """The pump schedule as a text table in ``system``'s units, with a total row."""
+    rows = schedule_rows(scene)
+    u = {kind: display_unit(kind, system) for kind in ("rate", "volume", "mass", "concentration", "time")}
+    header = ["stage", "", f"start [{u['time']}]", f"end [{u['time']}]", f"rate [{u['rate']}]",
+              f"clean [{u['volume']}]", f"slurry [{u['volume']}]", f"proppant [{u['mass']}]",
+              f"conc. [{u['concentration']}]"]
+
+    def number(value: Any, kind: str) -> str:
+        return "-" if value is None else format_number(in_display_units(value, kind, system))
+
+    body = []
+    for r in rows:
+        c0, c1 = r["concentration_start"], r["concentration_end"]
+        if r["kind"] != "slurry":
+            conc = "-"
+        elif c0 is None:
+            conc = "?"
+        elif math.isclose(c0, c1, rel_tol=1e-9):
+            conc = number(c0, "concentration")
+        else:
+            conc = f"{number(c0, 'concentration')}-{number(c1, 'concentration')}"
+        label = r["kind"] + (f" {r['proppant']}" if r["proppant"] else "")
+        body.append([str(r["stage"]), label, number(r["start"], "time"), number(r["end"], "time"),
+                     number(r["rate"], "rate"), number(r["clean_volume"], "volume"),
+                     number(r["slurry_volume"], "volume"),
+                     "-" if r["kind"] != "slurry" else number(r["mass"], "mass"), conc])
+    masses = [r["mass"] for r in rows if r["kind"] == "slurry"]
+    total_mass = None if any(m is None for m in masses) else sum(masses)
+    body.append(["total", "", "", number(rows[-1]["end"], "time") if rows else "", "",
+                 number(sum(r["clean_volume"] for r in rows), "volume"),
+                 number(sum(r["slurry_volume"] for r in rows), "volume"),
+                 number(total_mass, "mass") if masses else "-", ""])
+    if not any(r["kind"] == "slurry" for r in rows):  # no proppant: no proppant columns
+        header, body = header[:-2], [line[:-2] for line in body]
+    widths = [max(len(line[k]) for line in [header, *body]) for k in range(len(header))]
+    lines = ["pump schedule"]
+    for line in [header, *body]:
+        cells = [text.ljust(w) if k < 2 else text.rjust(w) for k, (text, w) in enumerate(zip(line, widths))]
+        lines.append("  " + "  ".join(cells).rstrip())
+    return "\n".join(lines)
