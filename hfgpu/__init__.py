@@ -6,6 +6,7 @@ Python API::
     scene = hfgpu.load_scene("scene.toml")
     hfgpu.run(scene, "results.h5")
     results = hfgpu.open_results("results.h5")
+    rows = hfgpu.sweep("study.toml", "study")   # an ensemble on Dask (docs/ensembles.md)
 """
 
 from .errors import HfgpuError, SceneError, SimulationError
@@ -28,4 +29,12 @@ def open_results(path):
     return _open(path)
 
 
-__all__ = ["HfgpuError", "Scene", "SceneError", "SimulationError", "load_scene", "open_results", "run"]
+def sweep(sweep_file, out, **options):
+    """Run a sweep file's ensemble on Dask into the folder ``out``; return the summary as a list of dicts, one per
+    member (docs/ensembles.md; options: workers, scheduler, resume, progress; see hfgpu.ensemble.execute)."""
+    from .ensemble.execute import sweep as _sweep
+
+    return _sweep(sweep_file, out, **options)
+
+
+__all__ = ["HfgpuError", "Scene", "SceneError", "SimulationError", "load_scene", "open_results", "run", "sweep"]

@@ -250,18 +250,21 @@ MISMATCH_WARNING = 0.05
 def warn_inconsistent_width(summary: dict) -> None:
     """A RuntimeWarning line when the open cells of the fracture's width history on the proppant grid stored
     more (or less) fluid than was injected and leaked off, by more than MISMATCH_WARNING of the injected fluid
-    (``summary`` of :meth:`ProppantSimulation.run`): the fluid step supplied the difference in the growing
-    cells (hfgpu.proppant.fluid.StepInfo.supplied; cells that open during a step are filled apart, as
-    ``opened``). Known causes: fracture cells with negative widths beside a stress barrier (no contact
-    constraint), whose fluid the proppant grid (w <= 0 closed) does not see; slurry held back at a screen-out
-    (the one-way coupled fracture assumed it entered)."""
-    supplied, injected = summary["fluid_supplied"], summary["fluid_injected"]
-    if injected > 0.0 and abs(supplied) > MISMATCH_WARNING * injected:
+    (``summary`` of :meth:`ProppantSimulation.run`). The fluid step's balance is injected + opened + supplied =
+    stored + leaked + outflow (hfgpu.proppant.fluid.StepInfo), with ``stored`` counting the fluid placed in
+    cells that open (``opened``) and not the fluid of cells that close (``dropped``), so the history's
+    mismatch is supplied + opened - dropped (tests/test_coupled.py checks ``supplied`` against the history).
+    Known causes: slurry held back at a screen-out (the one-way coupled fracture assumed it entered); fracture
+    cells with negative widths beside a stress barrier, whose fluid the proppant grid (w <= 0 closed) does not
+    see."""
+    injected = summary["fluid_injected"]
+    mismatch = summary["fluid_supplied"] + summary["fluid_opened"] - summary["fluid_dropped"]
+    if injected > 0.0 and abs(mismatch) > MISMATCH_WARNING * injected:
         warnings.warn(f"the fracture width history on the proppant grid is not mass-consistent with the injection: "
-                      f"its open cells needed {supplied:.4g} m^3 of fluid beyond the {injected:.4g} m^3 injected "
-                      f"less leak-off ({100 * supplied / injected:+.1f} %; cells that open are filled apart), "
-                      "supplied over the growing cells (known causes: slurry held back by a screen-out; the "
-                      "width interpolated linearly between fracture snapshots; coarse cells)", RuntimeWarning, stacklevel=3)
+                      f"its open cells stored {mismatch:.4g} m^3 of fluid beyond the {injected:.4g} m^3 injected "
+                      f"less leak-off ({100 * mismatch / injected:+.1f} %), supplied over the growing cells (known "
+                      "causes: slurry held back by a screen-out; the width interpolated linearly between fracture "
+                      "snapshots; coarse cells)", RuntimeWarning, stacklevel=3)
 
 
 def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None = None,
@@ -313,6 +316,8 @@ def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None =
     def wrap(state: dict) -> dict:
         return {"phase": "proppant", "fracture_summary": fracture, "screen_out": shift.state(), "proppant": state}
 
+    if hasattr(progress, "phase"):  # hfgpu.io.progress.Progress: a bar of its own for the proppant phase
+        progress.phase("proppant", start)
     proppant = sim.run(shift, None if progress is None else (lambda t: progress(t + start)),
                        checkpoint=checkpoint and checkpoint.within(start, wrap),
                        resume=resume["proppant"] if phase == "proppant" else None)

@@ -10,8 +10,10 @@ Only real limits are here, each with its reason (docs/stability.md has the matri
   initial suspension and scheduled proppant would make more parcels than fit in the machine's memory is
   refused up front instead of failing hours in.
 
-What the engines already refuse themselves (not repeated here): a first stage with rate 0, a starting fracture
-that needs longer than half the run to form (``fracture.initial_radius_cells``), c_max outside (0, 1).
+:func:`check_engine_start` (called by :func:`hfgpu.scene_checks.validate`, so by ``hfgpu check`` and ``hfgpu run``,
+not by ``check_limits``) raises what the fracture engine would refuse at its first step: a first stage with rate 0,
+and a starting fracture of ``fracture.initial_radius_cells`` cells (of the cells in use, after the preset's
+refinement) that would take longer than half the schedule to form.
 """
 
 from __future__ import annotations
@@ -44,6 +46,45 @@ def check_limits(scene, memory: int | None = None) -> None:
         return
     _check_packing(scene)
     _check_parcel_memory(scene, physical_memory() if memory is None else memory)
+
+
+def check_engine_start(scene) -> None:
+    """The fracture engine's start-up checks (hfgpu.fracture.simulator): what it would refuse at its first step."""
+    if scene.fracture is None:
+        return
+    import importlib
+
+    engine = importlib.import_module("hfgpu.fracture.simulator")
+    if hasattr(engine, "start_time"):  # (a stand-in simulator of the tests has neither check)
+        engine._check_scene(scene)
+        _start_check(scene, engine)
+
+
+def _start_check(scene, engine) -> None:
+    """The starting radial fracture (``fracture.initial_radius_cells`` x the larger cell in use) must form, at the
+    schedule's rates, within half the schedule and while a stage injects (as :class:`hfgpu.fracture.simulator._Engine`
+    requires)."""
+    import math
+
+    K_PRIME_FACTOR, start_time = engine.K_PRIME_FACTOR, engine.start_time
+    rock, inj, numerics = scene.rock, scene.injection, scene.fracture
+    r0 = numerics.initial_radius_cells * max(scene.mesh.dx, scene.mesh.dz)
+    k0 = K_PRIME_FACTOR * float(rock.toughness_at(np.array(inj.depth)))
+    c0 = 2.0 * float(rock.leakoff_at(np.array(inj.depth)))
+    t0, _ = start_time(inj.schedule, rock.plane_strain_modulus, 12.0 * scene.fluid.viscosity, k0, c0, r0)
+    if t0 >= 0.5 * inj.schedule.end or inj.schedule.rate(t0) <= 0.0:
+        from .units import display_unit, format_number, in_display_units
+
+        def length(value: float) -> str:
+            system = scene.output.units
+            return f"{format_number(in_display_units(value, 'length', system), 3)} {display_unit('length', system)}"
+
+        took = "longer than the schedule" if math.isinf(t0) else f"{t0:.3g} s"
+        raise SceneError("fracture.initial_radius_cells", numerics.initial_radius_cells,
+                         f"the starting fracture (radius {length(r0)}: this many cells of {length(scene.mesh.dx)} x "
+                         f"{length(scene.mesh.dz)} in use) would take {took} to form, past half the schedule "
+                         f"({inj.schedule.end:g} s) or in a stage that does not inject; use finer cells (or a "
+                         "preset that does not coarsen them)")
 
 
 def _check_packing(scene) -> None:

@@ -85,18 +85,25 @@ def effective_knobs(scene: Any) -> list[tuple[str, Any, str]]:
     return rows
 
 
+def knob_report(scene: Any, system: str = "SI") -> str:
+    """The lines ``hfgpu check`` prints: the preset, the cells in use (lengths in ``system``'s units) and each preset
+    knob with its origin."""
+    from .units import display_unit, format_number, in_display_units
 
-def knob_report(scene: Any) -> str:
-    """The lines ``hfgpu check`` prints: the preset, the cells in use and each preset knob with its origin."""
+    def length(value: float) -> str:
+        return format_number(in_display_units(value, "length", system))
+
+    unit = display_unit("length", system)
     dx, dz = scene.mesh.scene_cell_size
     lines = [f"preset {scene.run.preset}; numerical knobs in use (docs/presets.md):",
-             f"  {'mesh cells in use':32} {scene.mesh.dx:g} x {scene.mesh.dz:g} m = cell_size {dx:g} x {dz:g} m "
-             f"/ refinement {scene.mesh.refinement:g}"]
+             f"  {'mesh cells in use':32} {length(scene.mesh.dx)} x {length(scene.mesh.dz)} {unit} = cell_size "
+             f"{length(dx)} x {length(dz)} {unit} / refinement {scene.mesh.refinement:g}"]
     if scene.mesh.max_cells_across is not None:
         lines.append(f"  {'mesh.max_cells_across in use':32} {scene.mesh.max_cells_across} (scene value x refinement)")
     if scene.coupling is not None:
         size = scene.coupling.cell_size
-        shown = "the fracture cells" if size is None else f"{size[0]:g} x {size[1]:g} m (scene value / refinement)"
+        shown = "the fracture cells" if size is None else \
+            f"{length(size[0])} x {length(size[1])} {unit} (scene value / refinement)"
         lines.append(f"  {'coupling cells in use':32} {shown}")
     lines += [f"  {path:32} {value:<10g} {origin}" for path, value, origin in effective_knobs(scene)]
     return "\n".join(lines)

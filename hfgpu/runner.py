@@ -19,8 +19,9 @@ from typing import Any, Callable
 
 from .errors import HfgpuError
 from .interrupts import signal_number, stop_signals_interrupt
-from .limits import check_limits
-from .scene import Scene, load_scene
+from .scene import Scene
+from .scene_checks import validate
+from .threads import blas_thread_limit, blas_threads
 
 #: The module whose ``simulate(scene, sink, progress=None, checkpoint=None, resume=None) -> dict`` runs each
 #: physics set.
@@ -78,6 +79,7 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     is closed with status "failed: <message>" (every completed snapshot kept) and the error re-raised; Ctrl-C,
     SIGTERM and SIGHUP close it with status "interrupted" (summary and checkpoint kept, resumable) and re-raise
     the ``KeyboardInterrupt`` (:mod:`hfgpu.interrupts`).
+    BLAS uses one thread except in large dense solves (:mod:`hfgpu.threads`, ``HFGPU_BLAS_THREADS``).
     Checkpoints go into ``out`` every :func:`hfgpu.io.checkpoint.checkpoint_interval` of simulated time.
 
     ``resume``: continue the run in ``out`` from its last checkpoint (the scene must equal the one stored
@@ -85,12 +87,13 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     file then ends as an uninterrupted run's would. A file whose run is complete is left alone: a line says
     so and its stored summary is returned. The Rerun recording of a resumed run holds the resumed part only.
     """
-    scene = scene_or_path if isinstance(scene_or_path, Scene) else load_scene(scene_or_path)
-    check_limits(scene)
+    scene = validate(scene_or_path)  # as ``hfgpu check``: limits and the engine's start (hfgpu.scene_checks)
+    blas_thread_limit(0)  # a bad HFGPU_BLAS_THREADS is an error before any work
     simulate = simulator_for(scene)
     view, connect = _reachable_viewers(view, connect, viewer_required)
     from .io.checkpoint import Checkpointer, checkpoint_interval
-    from .io.progress import Progress, summary_table
+    from .io.progress import Progress
+    from .io.summary import schedule_table, summary_table
     from .io.results import ResultsWriter
 
     state = kept = None
@@ -111,12 +114,12 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     except BaseException as exc:
         writer.fail(str(exc) or type(exc).__name__)
         raise
-    bar = Progress(scene.run.end_time, enabled=progress)
+    bar = Progress(scene.run.end_time, enabled=progress, phase=scene.run.physics[0])
     if kept is not None:
         _carry_over(bar, kept)
     sinks.append(bar)
     try:
-        with stop_signals_interrupt():
+        with stop_signals_interrupt(), blas_threads(), bar.holding_warnings():  # printed after the bar
             result = simulate(scene, FanOut(sinks), progress=bar, checkpoint=checkpoint, resume=state)
     except KeyboardInterrupt as exc:
         _close_others(sinks[1:])
@@ -131,9 +134,33 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     summary = {**(result or {}), **bar.stats(), "status": "complete", "out": str(out),
                "checkpoints": checkpoint.written, "resumed_from": start if resume else math.nan}
     writer.close("complete", summary)
-    if progress:
-        print(summary_table(summary), flush=True)
+    closure = _write_closure(writer, scene) if scene.closure is not None else {}
+    summary.update(closure)
+    if progress:  # in the output units; the file keeps SI
+        if scene.injection is not None:
+            print(schedule_table(scene, scene.output.units), flush=True)
+        print(summary_table(summary, scene.output.units, scene), flush=True)
     return summary
+
+
+def _write_closure(writer: Any, scene: Scene) -> dict[str, Any]:
+    """Close the fracture on the proppant of the complete results file (:mod:`hfgpu.closure`): write ``/closure``
+    and its ``closure_*`` summary values, and return those (none when the run wrote no proppant snapshot; a failure
+    costs one line on stderr, the complete run stays as written)."""
+    from .closure.conductivity import closure_of
+    from .io.results import open_results
+
+    results = open_results(writer.path)
+    if not len(results.proppant_snapshots):
+        return {}
+    try:
+        closure = closure_of(results, scene)
+        writer.write_closure(closure.frame, closure.fields, {**closure.scalars, **closure.labels})
+    except Exception as exc:  # the run itself is complete and kept; closure is post-processing of it
+        print(f"hfgpu run: closure not computed: {' '.join(str(exc).splitlines()) or type(exc).__name__}",
+              file=sys.stderr, flush=True)
+        return {}
+    return closure.summary()
 
 
 def _reachable_viewers(view: bool, connect: str | None, required: bool) -> tuple[bool, str | None]:

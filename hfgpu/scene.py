@@ -1,11 +1,12 @@
 """Scene files: TOML in, typed frozen configuration out, validated before any work starts.
 
 Contract keys (outside tools rely on them; extend, never rename): ``[run] end_time, physics``;
-``[rock] youngs_modulus, poisson_ratio, toughness, leakoff_coefficient, min_stress, [[rock.layers]]
-top, bottom, min_stress, toughness, leakoff_coefficient``; ``[fluid] viscosity, density``;
-``[injection] depth, schedule = [{until, rate, proppant, volume_fraction, concentration,
-end_concentration}]``; ``[mesh] cell_size``; ``[output] every``; ``[geometry]`` and ``[[proppant]]``
-(see :mod:`hfgpu.proppant.config`). Depth z is positive downward; x is along the fracture length.
+``[rock] youngs_modulus, poisson_ratio, toughness, leakoff_coefficient, min_stress, pore_pressure,
+[[rock.layers]] top, bottom, min_stress, toughness, leakoff_coefficient, pore_pressure``; ``[fluid] viscosity,
+density``; ``[injection] depth, schedule = [{until, rate, proppant, volume_fraction, concentration,
+end_concentration}]``; ``[mesh] cell_size``; ``[output] every, units``; ``[geometry]`` and ``[[proppant]]``
+(see :mod:`hfgpu.proppant.config`); ``[closure]`` (see :mod:`hfgpu.closure.config`). Depth z is positive
+downward; x is along the fracture length.
 
 Physics-specific sections are parsed by their own folder (``hfgpu.fracture.config``,
 ``hfgpu.proppant.config``), imported only when the scene asks for that physics.
@@ -29,7 +30,8 @@ else:  # pragma: no cover
 
 from .errors import SceneError
 from .presets import DEFAULT_PRESET, PRESETS, Preset
-from .scene_reader import Table
+from .scene_reader import Table, collecting_warnings, raise_all
+from .units import majority_system
 
 PHYSICS = ("fracture", "proppant")
 
@@ -54,6 +56,7 @@ class Layer:
     min_stress: float | None = None
     toughness: float | None = None
     leakoff_coefficient: float | None = None
+    pore_pressure: float | None = None
 
 
 @dataclass(frozen=True)
@@ -64,6 +67,7 @@ class Rock:
     leakoff_coefficient: float
     min_stress: float
     layers: tuple[Layer, ...] = ()
+    pore_pressure: float = 0.0
 
     @property
     def plane_strain_modulus(self) -> float:
@@ -97,6 +101,10 @@ class Rock:
     def leakoff_at(self, z: np.ndarray) -> np.ndarray:
         """Carter coefficient C_L(z) [m/s^0.5]."""
         return self._layered(z, "leakoff_coefficient")
+
+    def pore_pressure_at(self, z: np.ndarray) -> np.ndarray:
+        """Reservoir (pore) pressure p_r(z) [Pa] (closure stress on a proppant pack: sigma_0 - p_r)."""
+        return self._layered(z, "pore_pressure")
 
 
 @dataclass(frozen=True)
@@ -211,6 +219,7 @@ class Mesh:
 class Output:
     every: float
     checkpoint_every: float | None = None
+    units: str = "SI"  # "SI" or "field": the units of what is printed, plotted and exported (docs/scene.md)
 
 
 @dataclass(frozen=True)
@@ -224,7 +233,10 @@ class Scene:
     fracture: Any = None  # hfgpu.fracture.config.FractureNumerics when "fracture" in physics
     proppant: Any = None  # hfgpu.proppant.config.ProppantSetup when "proppant" in physics
     coupling: Any = None  # hfgpu.coupled.CouplingConfig when physics has both "fracture" and "proppant"
+    closure: Any = None  # hfgpu.closure.config.ClosureConfig when "proppant" in physics
     source: str = field(default="", repr=False, compare=False)  # the TOML text, stored in results
+    #: One line each: what the scene reader found suspect but valid (bare numbers); hfgpu.scene_checks adds more.
+    warnings: tuple[str, ...] = field(default=(), repr=False, compare=False)
 
     def has(self, physics: str) -> bool:
         return physics in self.run.physics
@@ -266,47 +278,120 @@ def _read_file(path: Path) -> str:
 
 
 def parse_scene(data: dict, source: str = "") -> Scene:
-    """Validate a parsed TOML document into a :class:`Scene`."""
-    top = Table(data, "")
-    run = _parse_run(top.table("run"))
-    preset = PRESETS[run.preset]
-    fluid = _parse_fluid(top.table("fluid"))
-    mesh = _parse_mesh(top.table("mesh"), preset)
-    output = _parse_output(top.table("output"), run.end_time)
+    """Validate a parsed TOML document into a :class:`Scene`.
 
-    rock = injection = fracture = proppant = None
-    needs_rock = "fracture" in run.physics
-    rock_table = top.table("rock") if needs_rock else top.table("rock", None)
-    if rock_table is not None:
-        rock = _parse_rock(rock_table)
-    injection_table = top.table("injection") if needs_rock else top.table("injection", None)
-    if "fracture" in run.physics:
+    Every section is read even after another failed, so one :class:`~hfgpu.scene_reader.SceneErrors` reports the
+    errors of all sections (within a section, the first error stops it); a section that needs a failed one
+    (``[[proppant]]`` needs ``[run]``, ``[fluid]`` and ``[mesh]``; ``[closure]`` needs ``[[proppant]]`` and
+    ``[rock]``; ``[coupling]`` needs ``[run]`` and ``[mesh]``) is skipped, so that one mistake is reported once. The
+    warnings found while reading (bare numbers, :mod:`hfgpu.scene_reader`) are in ``Scene.warnings``.
+    """
+    with collecting_warnings() as found:
+        scene = _parse(data, source)
+    return dataclasses.replace(scene, warnings=tuple(found))
+
+
+class _Sections:
+    """Runs the parse of each section, keeping its SceneErrors; a failed section gives None."""
+
+    def __init__(self, top: Table):
+        self.top = top
+        self.errors: list[SceneError] = []
+
+    def __call__(self, keys: tuple[str, ...], parse, *args):
+        try:
+            return parse(*args)
+        except SceneError as exc:
+            self.errors.append(exc)
+            for key in keys:  # read, so that the top table does not call them unknown
+                self.top.raw(key, None)
+            return None
+
+    def skip(self, *keys: str) -> None:
+        for key in keys:
+            self.top.raw(key, None)
+
+
+def _physics_of(data: dict) -> tuple[str, ...] | None:
+    """``run.physics`` when ``[run]`` failed for another reason (else None)."""
+    run = data.get("run")
+    physics = run.get("physics", ["fracture"]) if isinstance(run, dict) else None
+    physics = [physics] if isinstance(physics, str) else physics
+    if isinstance(physics, list) and physics and all(p in PHYSICS for p in physics if isinstance(p, str)) \
+            and all(isinstance(p, str) for p in physics) and len(set(physics)) == len(physics):
+        return tuple(p for p in PHYSICS if p in physics)
+    return None
+
+
+def _parse(data: dict, source: str) -> Scene:
+    top = Table(data, "")
+    sections = _Sections(top)
+    run = sections(("run",), lambda: _parse_run(top.table("run")))
+    if run is not None:
+        preset, physics = PRESETS[run.preset], run.physics
+    else:
+        given = data.get("run", {}).get("preset") if isinstance(data.get("run"), dict) else None
+        preset = PRESETS.get(given, PRESETS[DEFAULT_PRESET]) if isinstance(given, str) else PRESETS[DEFAULT_PRESET]
+        physics = _physics_of(data)
+    fluid = sections(("fluid",), lambda: _parse_fluid(top.table("fluid")))
+    mesh = sections(("mesh",), lambda: _parse_mesh(top.table("mesh"), preset))
+    output = sections(("output",), lambda: _parse_output(top.table("output", {}),
+                                                         run.end_time if run is not None else None, data))
+
+    rock = injection = fracture = proppant = closure = coupling = None
+    if physics is None:  # unknown physics: the sections below cannot be judged
+        sections.skip("rock", "injection", "fracture", "proppant", "geometry", "mppic", "closure", "coupling")
+        raise_all(sections.errors)
+    needs_rock = "fracture" in physics
+    rock_failed = False
+    if needs_rock or top.has("rock"):
+        rock = sections(("rock",), lambda: _parse_rock(top.table("rock")))
+        rock_failed = rock is None
+    if "fracture" in physics:
         from .fracture.config import parse_fracture_numerics
 
-        fracture = parse_fracture_numerics(top.table("fracture", {}), preset)
-    if "proppant" in run.physics:
-        from .proppant.config import parse_proppant_setup
+        fracture = sections(("fracture",), lambda: parse_fracture_numerics(top.table("fracture", {}), preset))
+    proppant_failed = False
+    if "proppant" in physics:
+        keys = ("proppant", "geometry", "mppic")
+        if run is None or fluid is None or mesh is None:
+            sections.skip(*keys, "closure")
+            proppant_failed = True
+        else:
+            from .proppant.config import parse_proppant_setup
 
-        proppant = parse_proppant_setup(top, run=run, fluid=fluid, mesh=mesh)
+            proppant = sections(keys, parse_proppant_setup, top, run, fluid, mesh)
+            proppant_failed = proppant is None
+            if proppant is not None and not rock_failed:
+                from .closure.config import parse_closure
+
+                closure = sections(("closure",), lambda: parse_closure(top.table("closure", {}), proppant, rock))
+            else:
+                sections.skip("closure")
     else:
-        for key in ("proppant", "geometry", "mppic"):
+        for key in ("proppant", "geometry", "mppic", "closure"):
             if top.has(key):
                 top.raw(key)
-                raise SceneError(key, "(table)", 'this section needs "proppant" in run.physics')
-    if injection_table is not None:
-        densities = proppant.class_densities() if proppant is not None else {}
-        injection = _parse_injection(injection_table, densities)
-    coupling = None
-    if len(run.physics) > 1:
-        from .coupled import parse_coupling
+                sections.errors.append(SceneError(key, "(table)", 'this section needs "proppant" in run.physics'))
+    if needs_rock or top.has("injection"):
+        densities = None if proppant_failed else (proppant.class_densities() if proppant is not None else {})
+        injection = sections(("injection",), lambda: _parse_injection(top.table("injection"), densities))
+    if len(physics) > 1:
+        if run is None or mesh is None:
+            sections.skip("coupling")
+        else:
+            from .coupled import parse_coupling
 
-        coupling = parse_coupling(top.table("coupling", {}), run.end_time, mesh.refinement)
+            coupling = sections(("coupling",), lambda: parse_coupling(top.table("coupling", {}), run.end_time,
+                                                                       mesh.refinement))
     elif top.has("coupling"):
         top.raw("coupling")
-        raise SceneError("coupling", "(table)", 'this section needs both "fracture" and "proppant" in run.physics')
-    top.finish()
+        sections.errors.append(SceneError("coupling", "(table)",
+                                          'this section needs both "fracture" and "proppant" in run.physics'))
+    sections((), top.finish)
+    raise_all(sections.errors)
     return Scene(run=run, fluid=fluid, mesh=mesh, output=output, rock=rock, injection=injection,
-                 fracture=fracture, proppant=proppant, coupling=coupling, source=source)
+                 fracture=fracture, proppant=proppant, coupling=coupling, closure=closure, source=source)
 
 
 def _parse_run(t: Table) -> RunConfig:
@@ -354,52 +439,80 @@ def _parse_mesh(t: Table, preset: Preset) -> Mesh:
                 refinement=refinement)
 
 
-def _parse_output(t: Table, end_time: float) -> Output:
-    """``[output]``: ``checkpoint_every`` is None when absent (the default rule of hfgpu.io.checkpoint), 0 for
-    "0 s" or false (no checkpoints)."""
-    every = t.quantity("every", "time", end_time / 10.0, minimum=0.0, exclusive_minimum=True)
+#: Snapshots a run writes when ``[output] every`` is not given: every = end_time / DEFAULT_SNAPSHOTS.
+DEFAULT_SNAPSHOTS = 10
+
+
+def _parse_output(t: Table, end_time: float | None, data: dict) -> Output:
+    """``[output]`` (optional, every key too): ``every`` defaults to end_time / DEFAULT_SNAPSHOTS;
+    ``checkpoint_every`` is None when absent (the default rule of hfgpu.io.checkpoint), 0 for "0 s" or false (no
+    checkpoints); ``units`` defaults to the system most unit-bearing values of the scene use
+    (:func:`hfgpu.units.majority_system`). ``end_time`` None: [run] failed (the default spacing is then moot)."""
+    default_every = (end_time if end_time is not None else 1.0) / DEFAULT_SNAPSHOTS
+    every = t.quantity("every", "time", default_every, minimum=0.0, exclusive_minimum=True)
     off = t.raw("checkpoint_every", None) is False
     checkpoint = 0.0 if off else t.quantity("checkpoint_every", "time", None, minimum=0.0)
+    units = t.choice("units", ("SI", "field"), None) if t.raw("units", None) is not None else majority_system(data)
     t.finish()
-    return Output(every=every, checkpoint_every=checkpoint)
+    return Output(every=every, checkpoint_every=checkpoint, units=units)
 
 
 def _parse_rock(t: Table) -> Rock:
-    rock = dict(
-        youngs_modulus=t.quantity("youngs_modulus", "pressure", minimum=0.0, exclusive_minimum=True),
-        poisson_ratio=t.number("poisson_ratio", minimum=0.0, maximum=0.5, exclusive_maximum=True),
-        toughness=t.quantity("toughness", "toughness", 0.0, minimum=0.0),
-        leakoff_coefficient=t.quantity("leakoff_coefficient", "leakoff", 0.0, minimum=0.0),
-        min_stress=t.quantity("min_stress", "pressure", 0.0),
-    )
-    layers = []
-    for lt in t.tables("layers"):
-        layer = Layer(
-            top=lt.quantity("top", "length"),
-            bottom=lt.quantity("bottom", "length"),
-            min_stress=lt.quantity("min_stress", "pressure", None),
-            toughness=lt.quantity("toughness", "toughness", None, minimum=0.0),
-            leakoff_coefficient=lt.quantity("leakoff_coefficient", "leakoff", None, minimum=0.0),
+    """``[rock]`` and its ``[[rock.layers]]``: the errors of every layer are reported together."""
+    errors: list[SceneError] = []
+    try:
+        rock = dict(
+            youngs_modulus=t.quantity("youngs_modulus", "pressure", minimum=0.0, exclusive_minimum=True),
+            poisson_ratio=t.number("poisson_ratio", minimum=0.0, maximum=0.5, exclusive_maximum=True),
+            toughness=t.quantity("toughness", "toughness", 0.0, minimum=0.0),
+            leakoff_coefficient=t.quantity("leakoff_coefficient", "leakoff", 0.0, minimum=0.0),
+            min_stress=t.quantity("min_stress", "pressure", 0.0),
+            pore_pressure=t.quantity("pore_pressure", "pressure", 0.0),
         )
-        if layer.bottom <= layer.top:
-            raise SceneError(lt.key_path("bottom"), lt.data["bottom"],
-                             f"a layer's bottom must lie below its top ({lt.data['top']!r}); depth is "
-                             "positive downward")
-        lt.finish()
-        layers.append(layer)
-    ordered = sorted(layers, key=lambda layer: layer.top)
-    for above, below in zip(ordered, ordered[1:]):
-        if below.top < above.bottom - 1e-12:
-            raise SceneError(f"{t.key_path('layers')}", f"{above.top}..{above.bottom} m and "
-                             f"{below.top}..{below.bottom} m", "layers must not overlap")
+    except SceneError as exc:
+        errors.append(exc)
+    layers: list[tuple[int, Layer]] = []
+    for i, lt in enumerate(t.tables("layers")):
+        try:
+            layers.append((i, _parse_layer(lt)))
+        except SceneError as exc:
+            errors.append(exc)
+    raise_all(errors)
+    ordered = sorted(layers, key=lambda item: item[1].top)
+    for (i, above), (j, below) in zip(ordered, ordered[1:]):
+        if below.top < above.bottom - 1e-9 * max(1.0, abs(above.bottom)):
+            errors.append(SceneError(f"{t.key_path('layers')}[{j}].top", t.data["layers"][j]["top"],
+                                     f"layers must not overlap: {t.key_path('layers')}[{i}] spans "
+                                     f"{above.top:.6g}..{above.bottom:.6g} m, {t.key_path('layers')}[{j}] "
+                                     f"{below.top:.6g}..{below.bottom:.6g} m"))
+    raise_all(errors)
     t.finish()
-    return Rock(layers=tuple(layers), **rock)
+    return Rock(layers=tuple(layer for _, layer in layers), **rock)
+
+
+def _parse_layer(lt: Table) -> Layer:
+    layer = Layer(
+        top=lt.quantity("top", "length"),
+        bottom=lt.quantity("bottom", "length"),
+        min_stress=lt.quantity("min_stress", "pressure", None),
+        toughness=lt.quantity("toughness", "toughness", None, minimum=0.0),
+        leakoff_coefficient=lt.quantity("leakoff_coefficient", "leakoff", None, minimum=0.0),
+        pore_pressure=lt.quantity("pore_pressure", "pressure", None),
+    )
+    if layer.bottom <= layer.top:
+        raise SceneError(lt.key_path("bottom"), lt.data["bottom"],
+                         f"a layer's bottom must lie below its top ({lt.data['top']!r}); depth is "
+                         "positive downward")
+    lt.finish()
+    return layer
 
 
 STAGE_ENDS = ("until", "duration", "clean_volume")
 
 
-def _parse_injection(t: Table, proppant_densities: dict[str, float]) -> Injection:
+def _parse_injection(t: Table, proppant_densities: dict[str, float] | None) -> Injection:
+    """``[injection]``; ``proppant_densities`` None: [[proppant]] failed, so any class name is taken (and a
+    concentration's fraction is not checked)."""
     depth = t.quantity("depth", "length", 0.0)
     x = t.quantity("x", "length", 0.0)
     stages = []
@@ -417,7 +530,9 @@ def _parse_injection(t: Table, proppant_densities: dict[str, float]) -> Injectio
         rate = st.quantity("rate", "rate", minimum=0.0)
         name = st.string("proppant") if st.has("proppant") else None
         fraction = end_fraction = 0.0
-        if name is not None:
+        if name is not None and proppant_densities is None:  # [[proppant]] failed: its errors are reported
+            fraction, end_fraction = _stage_fractions(st, None)
+        elif name is not None:
             if name not in proppant_densities:
                 raise SceneError(st.key_path("proppant"), name, "must name a [[proppant]] class: "
                                  f"{sorted(proppant_densities) or 'none defined'}")
@@ -458,7 +573,7 @@ def _stage_end(st: Table, key: str, start: float, rate: float, mean_fraction: fl
     return until
 
 
-def _stage_fractions(st: Table, density: float) -> tuple[float, float]:
+def _stage_fractions(st: Table, density: float | None) -> tuple[float, float]:
     """Start/end slurry volume fraction of a stage from volume_fraction or concentration (ppa).
 
     A concentration c [kg per m^3 of clean fluid] gives the slurry fraction (c/rho_p) / (1 + c/rho_p).
@@ -470,6 +585,8 @@ def _stage_fractions(st: Table, density: float) -> tuple[float, float]:
     if st.has("concentration"):
         c0 = st.quantity("concentration", "concentration", minimum=0.0)
         c1 = st.quantity("end_concentration", "concentration", c0, minimum=0.0)
+        if density is None:
+            return 0.0, 0.0
         fractions = [(c / density) / (1.0 + c / density) for c in (c0, c1)]
         for key, f in zip(("concentration", "end_concentration"), fractions):
             if f > bounds["maximum"]:

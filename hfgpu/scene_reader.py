@@ -2,15 +2,73 @@
 
 :class:`Table` wraps a parsed TOML table and hands out checked values; each physics folder parses its
 own section with it, so the error format is the same everywhere. Keys a table does not know are an
-error too (a typo must not be silently ignored).
+error too (a typo must not be silently ignored), with the closest allowed key ("did you mean"); a required key
+that is missing names a close unknown key of the same table as the likely typo.
+
+Bare numbers: a plain number for a key that takes a unit is read as SI; unless it is 0 it adds a warning (one
+line). Warnings are collected, and the did-you-mean hints given, while :func:`collecting_warnings` is active (as in
+:func:`hfgpu.scene.parse_scene`; other files read with :class:`Table`, such as sweep files, keep the plain messages).
 """
 
 from __future__ import annotations
 
-from typing import Any, Iterable
+import contextlib
+import contextvars
+import difflib
+from typing import Any, Iterable, Iterator
 
 from .errors import MISSING, SceneError
 from .units import to_si
+
+_WARNINGS: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar("scene_warnings", default=None)
+
+
+class SceneErrors(SceneError):
+    """Several :class:`SceneError` of one scene, reported together (``errors``, in the order found); the message
+    has one line per error. ``path``, ``value`` and ``allowed`` are the first error's."""
+
+    def __init__(self, errors: list[SceneError]):
+        self.errors = list(errors)
+        first = self.errors[0]
+        self.path, self.value, self.allowed = first.path, first.value, first.allowed
+        Exception.__init__(self, "\n".join(str(e) for e in self.errors))
+
+
+def raise_all(errors: list[SceneError]) -> None:
+    """Raise nothing, the one error, or a :class:`SceneErrors` of them all."""
+    flat = [e for error in errors for e in (error.errors if isinstance(error, SceneErrors) else [error])]
+    if len(flat) == 1:
+        raise flat[0]
+    if flat:
+        raise SceneErrors(flat)
+
+
+@contextlib.contextmanager
+def collecting_warnings() -> Iterator[list[str]]:
+    """Collect the warnings of the tables read inside the block into the list it yields, and give did-you-mean
+    hints in the errors."""
+    found: list[str] = []
+    token = _WARNINGS.set(found)
+    try:
+        yield found
+    finally:
+        _WARNINGS.reset(token)
+
+
+def warn(message: str) -> None:
+    """Add a warning line to the active collection (dropped when none is active)."""
+    found = _WARNINGS.get()
+    if found is not None and message not in found:
+        found.append(message)
+
+
+def closest(key: str, allowed: Iterable[str]) -> str | None:
+    """The allowed key closest to ``key`` (difflib, similarity >= 0.6), or None (always None outside
+    :func:`collecting_warnings`)."""
+    if _WARNINGS.get() is None:
+        return None
+    match = difflib.get_close_matches(str(key), [str(a) for a in allowed], n=1, cutoff=0.6)
+    return match[0] if match else None
 
 
 class Table:
@@ -33,7 +91,9 @@ class Table:
         self._read.add(key)
         if key not in self.data:
             if default is MISSING:
-                raise SceneError(self.key_path(key), MISSING, "this key is required")
+                typo = closest(key, [k for k in self.data if k not in self._read])
+                hint = f"; found '{typo}': did you mean '{key}'?" if typo is not None else ""
+                raise SceneError(self.key_path(key), MISSING, "this key is required" + hint)
             return default
         return self.data[key]
 
@@ -45,6 +105,12 @@ class Table:
         if value is None:
             return None  # type: ignore[return-value]
         number = to_si(value, kind, self.key_path(key))
+        if kind != "dimensionless" and number != 0.0 and key in self.data and not isinstance(value, str):
+            from .units import SI_UNITS
+
+            unit = SI_UNITS[kind]
+            warn(f"scene key '{self.key_path(key)}': bare number {value!r} read as {value!r} {unit} (SI); write "
+                 f"the unit, e.g. \"{value} {unit}\"")
         check_bounds(self.key_path(key), value, number, kind, minimum, maximum,
                      exclusive_minimum, exclusive_maximum)
         return number
@@ -95,10 +161,14 @@ class Table:
     def finish(self) -> None:
         """Raise on keys that were never read: they are typos or unsupported."""
         unknown = sorted(set(self.data) - self._read)
-        if unknown:
-            known = ", ".join(sorted(self._read)) or "(none)"
-            raise SceneError(self.key_path(unknown[0]), self.data[unknown[0]],
-                             f"unknown key; keys allowed here: {known}")
+        known = ", ".join(sorted(self._read)) or "(none)"
+        errors = []
+        for key in unknown:
+            near = closest(key, self._read)
+            hint = f"did you mean '{near}'? " if near is not None else ""
+            errors.append(SceneError(self.key_path(key), self.data[key], f"unknown key; {hint}keys allowed here: "
+                                     f"{known}"))
+        raise_all(errors)
 
 
 def check_bounds(path: str, raw: Any, number: float, kind: str, minimum: float | None,

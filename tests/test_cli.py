@@ -91,7 +91,7 @@ def test_run_then_plot(tmp_path):
     done = _cli("plot", tmp_path / "r.h5")
     assert done.returncode == 0, done.stderr
     written = [Path(p) for p in done.stdout.split()]
-    assert len(written) == 4 and all(p.exists() and p.parent.name == "r_plots" for p in written)
+    assert len(written) == 5 and all(p.exists() and p.parent.name == "r_plots" for p in written)
 
 
 def test_failed_run_exit_2_and_status_in_file(tmp_path):

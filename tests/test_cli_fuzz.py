@@ -145,6 +145,17 @@ def one_error_line(capsys, command: str) -> str:
     return lines[0]
 
 
+def error_lines(capsys, command: str) -> list[str]:
+    """The error lines of a scene with one or more errors: nothing on stdout, each line short and one error."""
+    out, err = capsys.readouterr()
+    assert "Traceback" not in out + err and out == "", out + err
+    lines = err.strip().splitlines()
+    assert lines and all(line.startswith(f"hfgpu {command}: error: ") and len(line) <= MAX_MESSAGE
+                         for line in lines), err
+    assert len(set(lines)) == len(lines), err   # one mistake is reported once
+    return lines
+
+
 def no_work(*args, **kwargs):
     raise AssertionError("hfgpu run went past validation of an invalid scene")
 
@@ -184,9 +195,10 @@ def test_any_broken_scene_check_ok_or_one_line(capsys, text):
     if code == 0:
         out, err = capsys.readouterr()
         assert "ok; physics" in out and "Traceback" not in out + err
-    else:
+    else:  # every error of the scene, one line each (several changes may make several errors)
         assert code == 2
-        assert re.search(r"error: (scene key '[^']+'|run\.physics)", one_error_line(capsys, "check"))
+        for line in error_lines(capsys, "check"):
+            assert re.search(r"error: (scene key '[^']+'|run\.physics)", line), line
 
 
 @pytest.mark.parametrize("args", [["check", "/no/such/scene.toml"], ["run", "/no/such/scene.toml", "--out", "x.h5"]])

@@ -59,6 +59,7 @@ from scipy.optimize import brentq
 
 from ..errors import SceneError, SimulationError
 from ..records import BalanceRecord, FractureSnapshot, GridFrame
+from ..threads import blas_threads
 from .coarsen import coarsen
 from .config import FractureNumerics
 from .elasticity import ElasticityOperator
@@ -250,8 +251,6 @@ class _Engine:
             return self._step_subgrid(dt, keep_ends)
         g = self.grid
         start = g.copy() if keep_ends else None
-        sel = (self.rows, self.cols)
-        w_old = g["w"][sel]
         reach_old = self._front_reach(g["w"], g["p"], self.t)
         h = min(self.dx, self.dz)
         for attempt in range(self.num.max_step_retries + 1):
@@ -290,8 +289,9 @@ class _Engine:
         w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
         prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
                            demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted)
-        res = solve_step(prob, self.elastic, self.num.newton_tolerance, self.num.newton_max_iterations,
-                         None if w_start is None else np.where(w_start > 0.0, w_start, start_widths(prob)))
+        with blas_threads(self.ix.size):
+            res = solve_step(prob, self.elastic, self.num.newton_tolerance, self.num.newton_max_iterations,
+                             None if w_start is None else np.where(w_start > 0.0, w_start, start_widths(prob)))
         self.newton_iterations += res.iterations
         return res
 
@@ -540,9 +540,16 @@ class _Engine:
 
     # ------------------------------------------------------------------------------------------
     def balance(self) -> BalanceRecord:
-        stored = float(self.grid["w"][self.grid["active"]].sum()) * self.area
-        return BalanceRecord(time=self.t, injected=self.schedule.volume(self.t), stored=stored,
-                             leaked=self.leaked_total)
+        """The volume balance and the pressure history at the current state (records.BalanceRecord)."""
+        g = self.grid
+        stored = float(g["w"][g["active"]].sum()) * self.area
+        injected = self.schedule.volume(self.t)
+        pressure = float(g["p"][self.rows[self.inj], self.cols[self.inj]])
+        size = self.geometry(self.now())
+        return BalanceRecord(time=self.t, injected=injected, stored=stored, leaked=self.leaked_total,
+                             injection_pressure=pressure, net_pressure=pressure - float(self.sigma_a[self.inj]),
+                             efficiency=stored / injected if injected > 0.0 else math.nan, area=size["area"],
+                             length=size["length"], height=size["height"])
 
     def now(self) -> _View:
         """The current state as a :class:`_View`."""

@@ -1,19 +1,26 @@
 """Figures (matplotlib, no pyplot state) from a results file alone; ``hfgpu plot`` writes them as PNGs.
 
-Depth z is drawn downward; maps use each snapshot's own grid frame (cell centres x0 + i dx, z0 + j dz).
+Depth z is drawn downward; maps use each snapshot's own grid frame (cell centres x0 + i dx, z0 + j dz). The
+time panels of one map share one colour scale; every map of a layered scene draws the layer boundaries
+(``[[rock.layers]]``, depth positive down); outlines and markers have legends.
 Fracture: width maps at a few times with the cross-section at x = x_injection, footprint outlines over
 time, area and efficiency vs time, volume balance. Proppant (last snapshot): volume fraction map, map of
 the mean parcel speed per cell, parcels coloured by radius, solid balance. Coupled runs (both physics) add
 the paper's Figs. 13-18: volume fraction and speed maps over time, fluid streamlines, |u_p| probability
-plots at 1260 / 1800 / 3600 s (nearest snapshots), fracture and propped area vs time.
+plots at 1260 / 1800 / 3600 s (nearest snapshots), fracture and propped area vs time. Runs with proppant add
+the propped width and conductivity after closure (hfgpu.closure) in the scene's ``[output] units``. A
+proppant-only column (at most MAX_COLUMN_CELLS columns, taller than wide) adds its interface heights against time.
 """
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from ..errors import HfgpuError
 from ..records import GridFrame, ProppantSnapshot
@@ -33,10 +40,76 @@ def _aspect(frame: GridFrame, shape: tuple[int, int]) -> str:
     return "equal" if 0.25 <= (bottom - top) / (right - left) <= 4 else "auto"
 
 
-def _map(fig: Figure, ax, frame: GridFrame, values: np.ndarray, label: str, title: str) -> None:
-    image = ax.imshow(values, extent=_extent(frame, values.shape), origin="upper", interpolation="nearest")
-    fig.colorbar(image, ax=ax, label=label)
+#: A proppant-only run on at most this many columns of cells (and taller than wide) is a settling column.
+MAX_COLUMN_CELLS = 4
+#: Style of the layer boundaries drawn on maps.
+LAYER_STYLE = dict(color="0.85", ls="--", lw=0.8)
+
+
+def colour_range(*maps: np.ndarray) -> tuple[float, float]:
+    """One (vmin, vmax) for all of ``maps`` (their finite values): 0 at the bottom for non-negative fields, and
+    never an empty range (an all-zero map gets 0..1, not -0.1..0.1)."""
+    finite = [np.asarray(m, dtype=float)[np.isfinite(m)] for m in maps]
+    values = np.concatenate([f.ravel() for f in finite]) if finite else np.zeros(0)
+    if values.size == 0:
+        return 0.0, 1.0
+    low, high = float(values.min()), float(values.max())
+    low = min(low, 0.0) if low >= 0.0 else low
+    if high <= low:
+        high = low + (abs(low) if low else 1.0)
+    return low, high
+
+
+def _map(fig: Figure, ax, frame: GridFrame, values: np.ndarray, label: str, title: str,
+         limits: tuple[float, float] | None = None, colourbar: bool = True) -> None:
+    vmin, vmax = limits if limits is not None else colour_range(values)
+    image = ax.imshow(values, extent=_extent(frame, values.shape), origin="upper", interpolation="nearest",
+                      vmin=vmin, vmax=vmax)
+    if colourbar:
+        fig.colorbar(image, ax=ax, label=label)
     ax.set(xlabel="x [m]", ylabel="depth z [m]", title=title, aspect=_aspect(frame, values.shape))
+
+
+def layer_boundaries(results: Results) -> list[float]:
+    """Depths [m] of the boundaries between the layers of the stored scene (``[[rock.layers]]``; the outermost
+    layers extend to +-infinity, so the table's first top and last bottom are not boundaries); none when the
+    scene has no layers or does not parse."""
+    try:
+        rock = results.scene.rock
+    except (HfgpuError, ImportError, AttributeError):
+        return []
+    layers = sorted(getattr(rock, "layers", ()) or (), key=lambda layer: layer.top)
+    depths = {layer.bottom for layer in layers[:-1]} | {layer.top for layer in layers[1:]}
+    return sorted(depths)
+
+
+def draw_layers(ax, boundaries: Sequence[float], low: float, high: float, legend: bool = True) -> int:
+    """Horizontal lines at the layer ``boundaries`` between depths ``low`` and ``high`` [m] (the rest would stretch
+    the axes); a legend entry "layer boundary" unless ``legend`` is False. Returns how many were drawn."""
+    drawn = 0
+    for depth in boundaries:
+        if min(low, high) <= depth <= max(low, high):
+            ax.axhline(depth, **LAYER_STYLE, label="layer boundary" if drawn == 0 and legend else None)
+            drawn += 1
+    return drawn
+
+
+def _layers_on_map(ax, frame: GridFrame, shape: tuple[int, int], boundaries: Sequence[float],
+                   legend: bool = True) -> int:
+    _, _, bottom, top = _extent(frame, shape)
+    return draw_layers(ax, boundaries, top, bottom, legend)
+
+
+def _legend(ax, *extra: Line2D) -> None:
+    """A legend of the labelled artists (plus ``extra`` proxies) when there is any."""
+    handles, _ = ax.get_legend_handles_labels()
+    if handles or extra:
+        ax.legend(handles=[*handles, *extra], loc="lower right", fontsize=7, framealpha=0.7)
+
+
+def _number(value: float, fmt: str = ".4g", missing: str = "n/a") -> str:
+    """``value`` formatted, or ``missing`` when it is not finite (no 'nan' in a title)."""
+    return format(value, fmt) if value is not None and math.isfinite(value) else missing
 
 
 def _domain_figure(frame: GridFrame, shape: tuple[int, int]) -> Figure:
@@ -59,25 +132,36 @@ def injection_x(results: Results) -> float:
     return injection.x if injection is not None else 0.0
 
 
-def width_maps(results: Results, count: int = 4) -> Figure:
-    """Width maps [mm] at up to ``count`` times, each above its cross-section w(z) at x = x_injection."""
+def width_maps(results: Results, count: int = 4, boundaries: Sequence[float] | None = None) -> Figure:
+    """Width maps [mm] at up to ``count`` times on one colour scale, each above its cross-section w(z) at
+    x = x_injection (dashed line on the map), with the layer boundaries (default: the stored scene's)."""
+    boundaries = layer_boundaries(results) if boundaries is None else boundaries
     snaps = [results.fracture_snapshots[i] for i in _picks(len(results.fracture_snapshots), count)]
     fig = Figure(figsize=(4 * len(snaps), 7), layout="constrained")
     axes = fig.subplots(2, len(snaps), squeeze=False)
     x_inj = injection_x(results)
-    for top, bottom, snap in zip(axes[0], axes[1], snaps):
-        _map(fig, top, snap.frame, snap.width * 1e3, "width [mm]", f"t = {snap.time:.4g} s")
-        top.axvline(x_inj, color="w", lw=0.8, ls="--")
+    limits = colour_range(*(snap.width * 1e3 for snap in snaps))
+    for n, (top, bottom, snap) in enumerate(zip(axes[0], axes[1], snaps)):
+        _map(fig, top, snap.frame, snap.width * 1e3, "width [mm]", f"t = {_number(snap.time)} s", limits,
+             colourbar=n == len(snaps) - 1)
+        top.axvline(x_inj, color="w", lw=0.8, ls="--", label="cross-section (injection x)")
+        _layers_on_map(top, snap.frame, snap.width.shape, boundaries, legend=n == 0)
+        if n == 0:
+            _legend(top)
         x, z = snap.frame.centres(*snap.width.shape)
         column = int(np.argmin(np.abs(x - x_inj)))
-        bottom.plot(snap.width[:, column] * 1e3, z, "o-", ms=3)
+        bottom.plot(snap.width[:, column] * 1e3, z, "o-", ms=3, label="width")
+        draw_layers(bottom, boundaries, z[0] - snap.frame.dz / 2, z[-1] + snap.frame.dz / 2)
         bottom.invert_yaxis()
-        bottom.set(xlabel=f"width at x = {x[column]:.3g} m [mm]", ylabel="depth z [m]")
+        bottom.set(xlabel=f"width at x = {x[column]:.3g} m [mm]", ylabel="depth z [m]",
+                   xlim=(limits[0], limits[1] * 1.05))
     return fig
 
 
-def footprints(results: Results) -> Figure:
-    """Outline of the open region (width > 0) at every snapshot, coloured by time."""
+def footprints(results: Results, boundaries: Sequence[float] | None = None) -> Figure:
+    """Outline of the open region (width > 0) at every snapshot, coloured by time (the colour bar), with the
+    layer boundaries (default: the stored scene's)."""
+    boundaries = layer_boundaries(results) if boundaries is None else boundaries
     fig = Figure(figsize=(6, 5), layout="constrained")
     ax = fig.subplots()
     snaps = list(results.fracture_snapshots)
@@ -86,8 +170,13 @@ def footprints(results: Results) -> Figure:
         x, z = snap.frame.centres(*snap.width.shape)
         if min(snap.width.shape) >= 2 and (snap.width > 0).any():
             ax.contour(x, z, (snap.width > 0).astype(float), levels=[0.5], colors=[colour])
+    if snaps:
+        lows, highs = zip(*((s.frame.z0 - s.frame.dz / 2, s.frame.z0 + (s.width.shape[0] - 0.5) * s.frame.dz)
+                            for s in snaps))
+        draw_layers(ax, boundaries, min(lows), max(highs))
     ax.invert_yaxis()
-    ax.set(xlabel="x [m]", ylabel="depth z [m]", title="footprint over time", aspect="equal")
+    ax.set(xlabel="x [m]", ylabel="depth z [m]", title="footprint (width > 0) over time", aspect="equal")
+    _legend(ax, Line2D([], [], color="k", lw=1, label="footprint outline (colour: time)"))
     _time_colourbar(fig, ax, results.fracture_snapshots.times)
     return fig
 
@@ -108,32 +197,59 @@ def area_efficiency(results: Results) -> Figure:
     return fig
 
 
+def pressure_history(results: Results) -> Figure:
+    """Net pressure at the injection cell [MPa] against time, linear and log-log (a Nolte-Smith plot: slope
+    1/4 to 1/5 for a confined PKN-like fracture, negative for a radial or unconfined one), from the step
+    history (/fracture/balance)."""
+    b = results.fracture_balance
+    fig = Figure(figsize=(10, 4), layout="constrained")
+    left, right = fig.subplots(1, 2)
+    t, net = b["time"], b["net_pressure"] / 1e6
+    left.plot(t, net)
+    left.set(xlabel="time [s]", ylabel="net pressure at injection [MPa]", title="net pressure")
+    positive = (t > 0) & (net > 0)
+    right.loglog(t[positive], net[positive])
+    right.set(xlabel="time [s]", ylabel="net pressure at injection [MPa]", title="log-log (Nolte-Smith)")
+    return fig
+
+
 def volume_balance(results: Results) -> Figure:
     """Injected, stored and leaked volume [m^3] vs time; stored + leaked dotted (it should cover injected)."""
     return _balance(results.fracture_balance, ("injected", "stored", "leaked"), "fluid volume balance")
 
 
 def proppant_balance(results: Results) -> Figure:
-    """Injected, in-domain and outflow solid volume [m^3] vs time."""
-    return _balance(results.proppant_balance, ("injected", "in_domain", "outflow"), "proppant volume balance")
+    """Injected, in-domain, outflow and held-back (screened out at the inlet, when the file has it) solid volume
+    [m^3] vs time; their sum dotted (it should cover injected)."""
+    names = ("injected", "in_domain", "outflow") + (("screened_out",) if "screened_out" in results.proppant_balance
+                                                    else ())
+    return _balance(results.proppant_balance, names, "proppant (solid) volume balance",
+                    {"in_domain": "in the domain", "screened_out": "held back at the inlet (screened out)"})
 
 
-def _balance(b: dict[str, np.ndarray], names: tuple[str, str, str], title: str) -> Figure:
+def _balance(b: dict[str, np.ndarray], names: tuple[str, ...], title: str,
+             labels: dict[str, str] | None = None) -> Figure:
+    """``names[0]`` (what came in) and the others (where it went) vs time, with the others' sum dotted."""
+    labels = labels or {}
     fig = Figure(figsize=(7, 4.5), layout="constrained")
     ax = fig.subplots()
     for name in names:
-        ax.plot(b["time"], b[name], label=name)
-    ax.plot(b["time"], b[names[1]] + b[names[2]], "k:", label=f"{names[1]} + {names[2]}")
+        ax.plot(b["time"], b[name], label=labels.get(name, name))
+    ax.plot(b["time"], sum(b[name] for name in names[1:]), "k:",
+            label=" + ".join(labels.get(name, name).split(" (")[0] for name in names[1:]))
     ax.set(xlabel="time [s]", ylabel="volume [m^3]", title=title)
     ax.legend()
     return fig
 
 
-def volume_fraction_map(snap: ProppantSnapshot) -> Figure:
-    """Proppant volume fraction on the grid."""
+def volume_fraction_map(snap: ProppantSnapshot, boundaries: Sequence[float] = ()) -> Figure:
+    """Proppant volume fraction on the grid, with the layer ``boundaries`` [m depth]."""
     fig = _domain_figure(snap.frame, snap.grid["volume_fraction"].shape)
-    _map(fig, fig.subplots(), snap.frame, snap.grid["volume_fraction"], "volume fraction [-]",
-         f"proppant volume fraction, t = {snap.time:.4g} s")
+    ax = fig.subplots()
+    _map(fig, ax, snap.frame, snap.grid["volume_fraction"], "volume fraction [-]",
+         f"proppant volume fraction, t = {_number(snap.time)} s")
+    _layers_on_map(ax, snap.frame, snap.grid["volume_fraction"].shape, boundaries)
+    _legend(ax)
     return fig
 
 
@@ -148,30 +264,47 @@ def _mean_speed(snap: ProppantSnapshot) -> np.ndarray:
     return np.where(count > 0, total / np.maximum(count, 1), np.nan)
 
 
-def parcel_speed_map(snap: ProppantSnapshot) -> Figure:
-    """Mean parcel speed [m/s] per grid cell (cells without parcels left blank)."""
+def parcel_speed_map(snap: ProppantSnapshot, boundaries: Sequence[float] = ()) -> Figure:
+    """Mean parcel speed [m/s] per grid cell (cells without parcels left blank), with the layer ``boundaries``."""
     mean = _mean_speed(snap)
     fig = _domain_figure(snap.frame, mean.shape)
-    _map(fig, fig.subplots(), snap.frame, mean, "mean parcel speed [m/s]", f"parcel speed, t = {snap.time:.4g} s")
+    ax = fig.subplots()
+    _map(fig, ax, snap.frame, mean, "mean parcel speed [m/s]", f"parcel speed, t = {_number(snap.time)} s")
+    _layers_on_map(ax, snap.frame, mean.shape, boundaries)
+    _legend(ax)
     return fig
 
 
-def proppant_maps(results: Results, count: int = 4) -> Figure:
+def proppant_maps(results: Results, count: int = 4, boundaries: Sequence[float] | None = None) -> Figure:
     """Volume fraction (top row) and mean parcel speed (bottom row) at up to ``count`` times (the paper's
-    Fig. 14); cells flagged ``bridging_risk`` are outlined in red where the file has that field."""
+    Fig. 14), each row on one colour scale; cells flagged ``bridging_risk`` are outlined in red where the file
+    has that field; the layer boundaries (default: the stored scene's)."""
+    boundaries = layer_boundaries(results) if boundaries is None else boundaries
     snaps = [results.proppant_snapshots[i] for i in _picks(len(results.proppant_snapshots), count)]
     fig = Figure(figsize=(4.5 * len(snaps), 6), layout="constrained")
     axes = fig.subplots(2, len(snaps), squeeze=False)
-    for top, bottom, snap in zip(axes[0], axes[1], snaps):
-        _map(fig, top, snap.frame, snap.grid["volume_fraction"], "volume fraction [-]", f"t = {snap.time:.4g} s")
-        if "bridging_risk" in snap.grid and snap.grid["bridging_risk"].any() and min(snap.grid["width"].shape) > 1:
+    speeds = [_mean_speed(snap) for snap in snaps]
+    fractions = colour_range(*(snap.grid["volume_fraction"] for snap in snaps))
+    speed_range = colour_range(*speeds)
+    outlined = [("bridging_risk" in snap.grid and snap.grid["bridging_risk"].any()
+                 and min(snap.grid["width"].shape) > 1) for snap in snaps]
+    bridging = Line2D([], [], color="r", lw=0.8, label="bridging risk (width < bridging_factor x grain diameter)")
+    for n, (top, bottom, snap, speed) in enumerate(zip(axes[0], axes[1], snaps, speeds)):
+        last = n == len(snaps) - 1
+        shape = snap.grid["volume_fraction"].shape
+        _map(fig, top, snap.frame, snap.grid["volume_fraction"], "volume fraction [-]",
+             f"t = {_number(snap.time)} s", fractions, colourbar=last)
+        if outlined[n]:
             x, z = snap.frame.centres(*snap.grid["width"].shape)
             top.contour(x, z, snap.grid["bridging_risk"].astype(float), levels=[0.5], colors=["r"], linewidths=0.8)
-        _map(fig, bottom, snap.frame, _mean_speed(snap), "mean parcel speed [m/s]", "")
+        _map(fig, bottom, snap.frame, speed, "mean parcel speed [m/s]", "", speed_range, colourbar=last)
+        for ax in (top, bottom):
+            _layers_on_map(ax, snap.frame, shape, boundaries, legend=n == 0)
+    _legend(axes[0][0], *([bridging] if any(outlined) else []))  # one legend for the row
     return fig
 
 
-def streamlines(snap: ProppantSnapshot) -> Figure:
+def streamlines(snap: ProppantSnapshot, boundaries: Sequence[float] = ()) -> Figure:
     """Streamlines of the fluid velocity (face values averaged to the cell centres, zero in closed cells)
     over the width map [mm], coloured by speed (the paper's Fig. 13c, 15j-l)."""
     g, f = snap.grid, snap.frame
@@ -181,12 +314,15 @@ def streamlines(snap: ProppantSnapshot) -> Figure:
     u, v = np.where(width > 0, u, 0.0), np.where(width > 0, v, 0.0)
     fig = _domain_figure(f, width.shape)
     ax = fig.subplots()
-    _map(fig, ax, f, np.where(width > 0, width * 1e3, np.nan), "width [mm]", f"fluid streamlines, t = {snap.time:.4g} s")
+    _map(fig, ax, f, np.where(width > 0, width * 1e3, np.nan), "width [mm]",
+         f"fluid streamlines, t = {_number(snap.time)} s")
+    _layers_on_map(ax, f, width.shape, boundaries)
     x, z = f.centres(*width.shape)
     if min(width.shape) >= 2 and np.any(u) | np.any(v):
         lines = ax.streamplot(x, z, u, v, color=np.hypot(u, v), cmap="magma", density=1.2, linewidth=0.7)
         fig.colorbar(lines.lines, ax=ax, label="fluid speed [m/s]")
     ax.set(xlim=(x[0] - f.dx / 2, x[-1] + f.dx / 2), ylim=(z[-1] + f.dz / 2, z[0] - f.dz / 2))
+    _legend(ax)
     return fig
 
 
@@ -202,10 +338,13 @@ def speed_probability(results: Results, times: tuple[float, ...] | None = None) 
         snap = results.proppant_snapshots.at(t)
         speed = np.sort(np.hypot(snap.parcels["u"], snap.parcels["v"]))
         if speed.size:
-            ax.plot(speed, (np.arange(speed.size) + 0.5) / speed.size, ".", ms=2)
-        ax.axvline(PACKED_SPEED, color="k", ls=":", lw=0.8)
+            ax.plot(speed, (np.arange(speed.size) + 0.5) / speed.size, ".", ms=2, label="parcels")
+        ax.axvline(PACKED_SPEED, color="k", ls=":", lw=0.8, label=f"packed below {PACKED_SPEED:g} m/s")
+        packed = packed_fraction(snap.parcels) if speed.size else math.nan
         ax.set(xlabel="|u_p| [m/s]", ylabel="cumulative probability [-]", ylim=(0, 1),
-               title=f"t = {snap.time:.4g} s, packed {packed_fraction(snap.parcels):.2f}")
+               title=f"t = {_number(snap.time)} s, " + (f"packed {packed:.2f}" if math.isfinite(packed)
+                                                         else "no parcels"))
+        _legend(ax)
     return fig
 
 
@@ -225,7 +364,7 @@ def propped_area(results: Results) -> Figure:
     return fig
 
 
-def parcels_by_radius(snap: ProppantSnapshot) -> Figure:
+def parcels_by_radius(snap: ProppantSnapshot, boundaries: Sequence[float] = ()) -> Figure:
     """Parcel positions coloured by particle radius [um]."""
     shape = snap.grid["volume_fraction"].shape
     fig = _domain_figure(snap.frame, shape)
@@ -237,7 +376,9 @@ def parcels_by_radius(snap: ProppantSnapshot) -> Figure:
     left, right, bottom, top = _extent(snap.frame, shape)
     ax.set(xlim=(left, right), ylim=(bottom, top), xlabel="x [m]", ylabel="depth z [m]",
            aspect=_aspect(snap.frame, shape),
-           title=f"parcels by radius, t = {snap.time:.4g} s")
+           title=f"parcels by radius, t = {_number(snap.time)} s")
+    _layers_on_map(ax, snap.frame, shape, boundaries)
+    _legend(ax)
     return fig
 
 
@@ -256,24 +397,130 @@ def _time_colourbar(fig: Figure, ax, times: np.ndarray) -> None:
                  ax=ax, label="time [s]")
 
 
+def closure_maps(closure, system: str = "SI", boundaries: Sequence[float] = ()) -> Figure:
+    """Propped width and conductivity after closure (:mod:`hfgpu.closure`), in ``system``'s units ("SI" or
+    "field"; the axes stay in m), with the layer ``boundaries``."""
+    from ..closure.display import in_units, unit_label
+
+    shape = closure.fields["propped_width"].shape
+    wide = shape[1] * closure.frame.dx >= shape[0] * closure.frame.dz
+    fig = Figure(figsize=(8, 7) if wide else (9, 6), layout="constrained")
+    for ax, name, title in zip(fig.subplots(2, 1) if wide else fig.subplots(1, 2), ("propped_width", "conductivity"),
+                               ("propped width after closure", "conductivity after closure")):
+        values = np.where(closure.fields["propped"] > 0, in_units(name, closure.fields[name], system), np.nan)
+        _map(fig, ax, closure.frame, values, f"{name.replace('_', ' ')} [{unit_label(name, system)}]",
+             f"{title} (t = {_number(closure.scalars.get('time', math.nan))} s)")
+        _layers_on_map(ax, closure.frame, shape, boundaries)
+        _legend(ax)
+    return fig
+
+
+def is_column(results: Results) -> bool:
+    """A proppant-only run on at most MAX_COLUMN_CELLS columns of cells, taller than wide (a settling column)."""
+    if len(results.fracture_snapshots) or not len(results.proppant_snapshots):
+        return False
+    nz, nx = results.proppant_snapshots[0].grid["volume_fraction"].shape
+    return nx <= MAX_COLUMN_CELLS and nz > nx
+
+
+def _theta_cp(results: Results) -> float:
+    """Close packing of the stored scene (0.6 when it does not parse)."""
+    try:
+        return float(results.scene.proppant.params.theta_cp)
+    except (HfgpuError, ImportError, AttributeError):
+        return 0.6
+
+
+def interface_heights(results: Results) -> dict[str, np.ndarray]:
+    """Heights above the column's bottom [m] against time of the top of the suspension (where the width-weighted
+    row profile of theta_p first rises through half the first snapshot's suspension value, going down) and of
+    the bed top (where it rises through the midpoint of that value and close packing), at every proppant
+    snapshot; also the two levels used (:func:`hfgpu.proppant.analysis.interface_depth`)."""
+    from ..proppant.analysis import interface_depth, row_profile
+
+    snaps = list(results.proppant_snapshots)
+    first = row_profile(snaps[0].grid["volume_fraction"], snaps[0].grid["width"])
+    suspension = float(np.median(first[first > 0])) if (first > 0).any() else 0.5 * _theta_cp(results)
+    top_level, bed_level = 0.5 * suspension, 0.5 * (suspension + _theta_cp(results))
+    out = {"time": np.array([s.time for s in snaps]), "suspension_top": [], "bed_top": []}
+    for snap in snaps:
+        profile = row_profile(snap.grid["volume_fraction"], snap.grid["width"])
+        bottom = snap.frame.z0 + (profile.size - 0.5) * snap.frame.dz
+        out["suspension_top"].append(bottom - interface_depth(profile, snap.frame, top_level))
+        out["bed_top"].append(bottom - interface_depth(profile, snap.frame, bed_level))
+    return {**{k: np.asarray(v, dtype=float) for k, v in out.items()}, "suspension_level": top_level,
+            "bed_level": bed_level}
+
+
+def column_interfaces(results: Results) -> Figure:
+    """Top of the suspension and bed top [m above the bottom] against time in a settling column
+    (:func:`interface_heights`)."""
+    h = interface_heights(results)
+    snap = results.proppant_snapshots[0]
+    height = snap.grid["volume_fraction"].shape[0] * snap.frame.dz
+    fig = Figure(figsize=(7, 4.5), layout="constrained")
+    ax = fig.subplots()
+    ax.plot(h["time"], h["suspension_top"], "o-", ms=3,
+            label=f"top of the suspension (theta_p = {h['suspension_level']:.3g})")
+    ax.plot(h["time"], h["bed_top"], "s-", ms=3, label=f"bed top (theta_p = {h['bed_level']:.3g})")
+    ax.set(xlabel="time [s]", ylabel="height above the bottom [m]", ylim=(0, height * 1.02),
+           title="settling column: interface heights")
+    ax.legend()
+    return fig
+
+
+def _closure(results: Results):
+    """The results' closure map (stored, or computed from the last proppant snapshot), None when the stored scene
+    has no proppant or does not parse."""
+    from ..closure.conductivity import closure_of
+
+    try:
+        return closure_of(results)
+    except HfgpuError:
+        return None
+
+
 def figures(results: Results) -> dict[str, Figure]:
     """Every figure the results support, by file stem."""
     out: dict[str, Figure] = {}
+    layers = layer_boundaries(results)
     if len(results.fracture_snapshots):
-        out.update(fracture_width=width_maps(results), fracture_footprints=footprints(results),
+        out.update(fracture_width=width_maps(results, boundaries=layers),
+                   fracture_footprints=footprints(results, boundaries=layers),
                    fracture_area_efficiency=area_efficiency(results))
     if results.fracture_balance:
         out["fracture_volume_balance"] = volume_balance(results)
+        if np.isfinite(results.fracture_balance.get("net_pressure", np.nan)).any():
+            out["pressure_history"] = pressure_history(results)
     if len(results.proppant_snapshots):
         last = results.proppant_snapshots[-1]
-        out.update(proppant_volume_fraction=volume_fraction_map(last), proppant_speed=parcel_speed_map(last),
-                   proppant_radius=parcels_by_radius(last))
+        out.update(proppant_volume_fraction=volume_fraction_map(last, layers),
+                   proppant_speed=parcel_speed_map(last, layers), proppant_radius=parcels_by_radius(last, layers))
+        closure = _closure(results)
+        if closure is not None:
+            from .export import output_units
+
+            out["closure_maps"] = closure_maps(closure, output_units(results), layers)
     if results.proppant_balance:
         out["proppant_volume_balance"] = proppant_balance(results)
+    if is_column(results):
+        out["proppant_interfaces"] = column_interfaces(results)
     if len(results.fracture_snapshots) and len(results.proppant_snapshots):  # a coupled run
-        out.update(proppant_maps=proppant_maps(results), proppant_streamlines=streamlines(results.proppant_snapshots[-1]),
+        out.update(proppant_maps=proppant_maps(results, boundaries=layers),
+                   proppant_streamlines=streamlines(results.proppant_snapshots[-1], layers),
                    proppant_speed_probability=speed_probability(results), propped_area=propped_area(results))
     return out
+
+
+#: The figure names (file stems) ``figures`` can produce, by the kind of results that produces them.
+FIGURE_NAMES = {
+    "fracture": ("fracture_width", "fracture_footprints", "fracture_area_efficiency", "fracture_volume_balance",
+                 "pressure_history"),
+    "proppant": ("proppant_volume_fraction", "proppant_speed", "proppant_radius", "closure_maps",
+                 "proppant_volume_balance"),
+    "column": ("proppant_interfaces",),
+    "coupled": ("proppant_maps", "proppant_streamlines", "proppant_speed_probability", "propped_area"),
+}
 
 
 def plot_results(path: str | Path, folder: str | Path, dpi: int = 120) -> list[Path]:

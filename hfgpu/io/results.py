@@ -9,6 +9,7 @@ Layout (docs/results-format.md is the full contract; extend, never rename)::
     /proppant/snapshots/000000 ...   attrs time, dx, dz, x0, z0, n_parcels; per-parcel and grid datasets
     /proppant/balance       time, injected, in_domain, outflow, screened_out (1-D, appended)
     /summary                attrs status, message, and the simulator's scalar summary values
+    /closure                attrs dx, dz, x0, z0, time and the closure scalars; propped_width, conductivity, ...
     /checkpoint             attrs time and record counts; state/...: the simulator's state (removed when complete)
 
 Integrity: the file is open only while a snapshot is written, and every change is made on a copy that is
@@ -53,7 +54,7 @@ NEW_CHECKPOINT = "_checkpoint_new"
 #: Units of every dataset name the writer knows (SI; "1" is dimensionless, "" is text or a label).
 UNITS = {
     "time": "s", "injected": "m^3", "stored": "m^3", "leaked": "m^3", "in_domain": "m^3", "outflow": "m^3",
-    "screened_out": "m^3",
+    "screened_out": "m^3", "injection_pressure": "Pa", "efficiency": "1",
     "width": "m", "pressure": "Pa", "leakoff_rate": "m/s", "opening_time": "s",
     "net_pressure": "Pa", "min_stress": "Pa", "toughness": "Pa m^0.5", "leakoff_coefficient": "m/s^0.5",
     "x": "m", "z": "m", "u": "m/s", "v": "m/s", "radius": "m", "density": "kg/m^3", "particles": "1",
@@ -64,11 +65,15 @@ UNITS = {
     **{f"front_{k}": "m" for k in ("radius", "radius_min", "radius_max", "up", "down", "left", "right")},
     "area": "m^2", "area_radius": "m", "length": "m", "height": "m",
     "injected_volume": "m^3", "stored_volume": "m^3", "leaked_volume": "m^3",
+    # /closure (hfgpu.closure.conductivity.ClosureMap.fields)
+    "propped_width": "m", "conductivity": "m^3", "closure_stress": "Pa", "permeability": "m^2",
+    "solid_volume": "m^3", "sauter_diameter": "m", "propped": "1",
 }
 UNKNOWN_UNITS = "unspecified"
 
 FRACTURE_FIELDS = ("width", "pressure", "leakoff_rate", "opening_time")
-FRACTURE_BALANCE = ("time", "injected", "stored", "leaked")
+FRACTURE_BALANCE = ("time", "injected", "stored", "leaked", "injection_pressure", "net_pressure", "efficiency",
+                    "area", "length", "height")
 PROPPANT_BALANCE = ("time", "injected", "in_domain", "outflow", "screened_out")
 _BALANCE_FLUSH_ROWS = 4096
 _COMPRESS_ABOVE = 4096  # elements; smaller arrays are stored plainly
@@ -237,6 +242,19 @@ class ResultsWriter:
             group.attrs.update(values)
             f.attrs["status"] = status
 
+    def write_closure(self, frame: GridFrame, fields: dict[str, np.ndarray], attrs: dict[str, Any]) -> None:
+        """Replace ``/closure`` (grid ``fields`` on ``frame``, scalar ``attrs``) and add ``attrs`` prefixed
+        ``closure_`` to ``/summary``, in one atomic edit (after :meth:`close`)."""
+        with _edit(self.path) as f:
+            f.pop("closure", None)
+            group = f.create_group("closure")
+            group.attrs.update(dx=float(frame.dx), dz=float(frame.dz), x0=float(frame.x0), z0=float(frame.z0),
+                               **attrs)
+            for name, array in fields.items():
+                _dataset(group, name, _array(array)).attrs["kind"] = "grid"
+            summary = f.require_group("summary")
+            summary.attrs.update({f"closure_{k}": v for k, v in attrs.items()})
+
     def fail(self, message: str, summary: dict[str, Any] | None = None) -> None:
         """Close with status "failed: <message>"."""
         self.close(f"failed: {message}", summary)
@@ -376,6 +394,17 @@ class Results:
     fracture_balance: dict[str, np.ndarray] = field(repr=False)
     proppant_balance: dict[str, np.ndarray] = field(repr=False)
     checkpoint_time: float | None = None
+
+    @functools.cached_property
+    def closure(self) -> dict[str, Any] | None:
+        """The ``/closure`` group: {"frame": GridFrame, "fields": {name: array}, "attrs": {name: value}}; None
+        when the file has none (:func:`hfgpu.closure.conductivity.closure_of` computes it then)."""
+        with _open(self.path, "r") as f:
+            group = f.get("closure")
+            if group is None:
+                return None
+            return dict(frame=_frame(group), fields={name: ds[()] for name, ds in group.items()},
+                        attrs={k: _plain(v) for k, v in group.attrs.items()})
 
     @functools.cached_property
     def scene(self):

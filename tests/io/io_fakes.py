@@ -76,8 +76,11 @@ def simulate_fracture(scene, sink, progress=None, steps: int = 40, snapshot_ever
         t = i * dt
         if fail_at is not None and i == fail_at:
             raise SimulationError("Newton did not converge", time=t, cell=(3, 4), residual=1.5e-2)
+        net = 2e6 * t ** -0.2  # a radial fracture's falling net pressure
         sink.fracture_balance(BalanceRecord(time=t, injected=RATE * t, stored=0.8 * RATE * t,
-                                            leaked=0.2 * RATE * t))
+                                            leaked=0.2 * RATE * t, injection_pressure=60e6 + net,
+                                            net_pressure=net, efficiency=0.8, area=10.0 * t, length=3.0 * t ** 0.5,
+                                            height=3.0 * t ** 0.5))
         if progress is not None:
             progress(t)
         if i % snapshot_every == 0:

@@ -18,7 +18,8 @@ def test_fracture_and_proppant_figures(tmp_path):
     fracture = plot_results(tmp_path / "f.h5", tmp_path / "f")
     proppant = plot_results(tmp_path / "p.h5", tmp_path / "p")
     assert [p.name for p in fracture] == ["fracture_width.png", "fracture_footprints.png",
-                                          "fracture_area_efficiency.png", "fracture_volume_balance.png"]
+                                          "fracture_area_efficiency.png", "fracture_volume_balance.png",
+                                          "pressure_history.png"]
     assert [p.name for p in proppant] == ["proppant_volume_fraction.png", "proppant_speed.png",
                                           "proppant_radius.png", "proppant_volume_balance.png"]
     for path in fracture + proppant:

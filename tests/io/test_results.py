@@ -17,7 +17,7 @@ import pytest
 from io_fakes import FRACTURE_SCENE, fracture_snapshot, proppant_scene, proppant_snapshot
 from hfgpu import load_scene, open_results
 from hfgpu.errors import HfgpuError
-from hfgpu.io.results import ResultsWriter
+from hfgpu.io.results import FRACTURE_BALANCE, ResultsWriter
 from hfgpu.records import BalanceRecord, SolidBalanceRecord
 
 
@@ -28,7 +28,8 @@ def test_round_trip_fracture(tmp_path):
     with ResultsWriter(path, scene) as w:
         for i in range(1, 51):
             t = 0.1 * i
-            w.fracture_balance(BalanceRecord(time=t, injected=t, stored=0.7 * t, leaked=0.3 * t))
+            w.fracture_balance(BalanceRecord(time=t, injected=t, stored=0.7 * t, leaked=0.3 * t,
+                                             injection_pressure=61e6 + t, net_pressure=1e6 + t))
             if i in (10, 25, 50):
                 w.fracture_snapshot(written[(10, 25, 50).index(i)])
     r = open_results(path)
@@ -44,7 +45,9 @@ def test_round_trip_fracture(tmp_path):
         np.testing.assert_array_equal(back.extras["net_pressure"], snap.extras["net_pressure"])
     assert r.fracture_snapshots.at(2.4).time == 2.5
     bal = r.fracture_balance
-    assert set(bal) == {"time", "injected", "stored", "leaked"} and bal["time"].size == 50
+    assert set(bal) == set(FRACTURE_BALANCE) and bal["time"].size == 50
+    np.testing.assert_array_equal(bal["injection_pressure"] - bal["net_pressure"], 60e6)
+    assert np.isnan(bal["area"]).all()  # not given: NaN
     np.testing.assert_allclose(bal["stored"] + bal["leaked"], bal["injected"], rtol=1e-15)
     assert r.summary["status"] == "complete" and r.summary["fracture_snapshots"] == 3
     assert r.summary["sim_time"] == pytest.approx(5.0)
