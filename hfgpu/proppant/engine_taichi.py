@@ -38,7 +38,7 @@ class TaichiEngine:
     name = "taichi"
     PRIVATE_COPIES = 16
     PRIVATE_BYTES = 64 * 2 ** 20
-    PARCELS_PER_COPY = 4096
+    PARCELS_PER_COPY = 1024
 
     def __init__(self, grid: StaggeredGrid, params: MppicParams, fluid_density: float, fluid_viscosity: float,
                  gravity: float, outlets: np.ndarray, arch: str | None = None, private: bool | None = None):
