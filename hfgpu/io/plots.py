@@ -8,8 +8,11 @@ time, area and efficiency vs time, volume balance. Proppant (last snapshot): vol
 the mean parcel speed per cell, parcels coloured by radius, solid balance. Coupled runs (both physics) add
 the paper's Figs. 13-18: volume fraction and speed maps over time, fluid streamlines, |u_p| probability
 plots at 1260 / 1800 / 3600 s (nearest snapshots), fracture and propped area vs time. Runs with proppant add
-the propped width and conductivity after closure (hfgpu.closure) in the scene's ``[output] units``. A
-proppant-only column (at most MAX_COLUMN_CELLS columns, taller than wide) adds its interface heights against time.
+the propped width and conductivity after closure (hfgpu.closure). A proppant-only column (at most
+MAX_COLUMN_CELLS columns, taller than wide) adds its interface heights against time.
+Every figure draws in the results' ``[output] units`` (:mod:`hfgpu.io.display_units`: SI as stored, widths in
+mm, pressures in MPa; or field: ft, in, psi, bbl, ft^3, ft^2, ft/s); times stay in s. Functions that take a results
+file read its units (``units=`` overrides them); those that take a snapshot draw SI unless given ``units``.
 """
 
 from __future__ import annotations
@@ -24,14 +27,28 @@ from matplotlib.lines import Line2D
 
 from ..errors import HfgpuError
 from ..records import GridFrame, ProppantSnapshot
+from .display_units import SI, FigureUnits
 from .results import Results, open_results
 
 
-def _extent(frame: GridFrame, shape: tuple[int, int]) -> tuple[float, float, float, float]:
-    """imshow extent (left, right, bottom, top) of a (nz, nx) grid with depth increasing downward."""
+def _extent(frame: GridFrame, shape: tuple[int, int], units: FigureUnits = SI) -> tuple[float, float, float, float]:
+    """imshow extent (left, right, bottom, top) of a (nz, nx) grid with depth increasing downward, in the length
+    unit of ``units``."""
     nz, nx = shape
-    return (frame.x0 - frame.dx / 2, frame.x0 + (nx - 0.5) * frame.dx,
-            frame.z0 + (nz - 0.5) * frame.dz, frame.z0 - frame.dz / 2)
+    edges = (frame.x0 - frame.dx / 2, frame.x0 + (nx - 0.5) * frame.dx,
+             frame.z0 + (nz - 0.5) * frame.dz, frame.z0 - frame.dz / 2)
+    return edges if not units.field else tuple(units("length", edges).tolist())
+
+
+def _units(results: Results, units: FigureUnits | None = None) -> FigureUnits:
+    """``units``, or the results' ``[output] units`` (SI when the stored scene does not parse)."""
+    from .export import output_units
+
+    return units if units is not None else FigureUnits(output_units(results))
+
+
+def _xz_labels(units: FigureUnits) -> dict[str, str]:
+    return dict(xlabel=f"x [{units.label('length')}]", ylabel=f"depth z [{units.label('length')}]")
 
 
 def _aspect(frame: GridFrame, shape: tuple[int, int]) -> str:
@@ -61,13 +78,14 @@ def colour_range(*maps: np.ndarray) -> tuple[float, float]:
 
 
 def _map(fig: Figure, ax, frame: GridFrame, values: np.ndarray, label: str, title: str,
-         limits: tuple[float, float] | None = None, colourbar: bool = True) -> None:
+         limits: tuple[float, float] | None = None, colourbar: bool = True, units: FigureUnits = SI) -> None:
+    """``values`` (already in their figure unit) on the grid ``frame`` (SI), the axes in ``units``' length."""
     vmin, vmax = limits if limits is not None else colour_range(values)
-    image = ax.imshow(values, extent=_extent(frame, values.shape), origin="upper", interpolation="nearest",
+    image = ax.imshow(values, extent=_extent(frame, values.shape, units), origin="upper", interpolation="nearest",
                       vmin=vmin, vmax=vmax)
     if colourbar:
         fig.colorbar(image, ax=ax, label=label)
-    ax.set(xlabel="x [m]", ylabel="depth z [m]", title=title, aspect=_aspect(frame, values.shape))
+    ax.set(**_xz_labels(units), title=title, aspect=_aspect(frame, values.shape))
 
 
 def layer_boundaries(results: Results) -> list[float]:
@@ -84,8 +102,9 @@ def layer_boundaries(results: Results) -> list[float]:
 
 
 def draw_layers(ax, boundaries: Sequence[float], low: float, high: float, legend: bool = True) -> int:
-    """Horizontal lines at the layer ``boundaries`` between depths ``low`` and ``high`` [m] (the rest would stretch
-    the axes); a legend entry "layer boundary" unless ``legend`` is False. Returns how many were drawn."""
+    """Horizontal lines at the layer ``boundaries`` between depths ``low`` and ``high`` (all in the axes' unit;
+    the rest would stretch the axes); a legend entry "layer boundary" unless ``legend`` is False. Returns how many
+    were drawn."""
     drawn = 0
     for depth in boundaries:
         if min(low, high) <= depth <= max(low, high):
@@ -95,9 +114,15 @@ def draw_layers(ax, boundaries: Sequence[float], low: float, high: float, legend
 
 
 def _layers_on_map(ax, frame: GridFrame, shape: tuple[int, int], boundaries: Sequence[float],
-                   legend: bool = True) -> int:
-    _, _, bottom, top = _extent(frame, shape)
-    return draw_layers(ax, boundaries, top, bottom, legend)
+                   legend: bool = True, units: FigureUnits = SI) -> int:
+    """The layer ``boundaries`` [m depth] on a map drawn in ``units``."""
+    _, _, bottom, top = _extent(frame, shape, units)
+    return draw_layers(ax, _lengths(boundaries, units), top, bottom, legend)
+
+
+def _lengths(values: Sequence[float], units: FigureUnits) -> Sequence[float]:
+    """SI lengths in ``units`` (unchanged, as given, in SI)."""
+    return values if not units.field or not len(values) else units("length", values).tolist()
 
 
 def _legend(ax, *extra: Line2D) -> None:
@@ -132,36 +157,42 @@ def injection_x(results: Results) -> float:
     return injection.x if injection is not None else 0.0
 
 
-def width_maps(results: Results, count: int = 4, boundaries: Sequence[float] | None = None) -> Figure:
-    """Width maps [mm] at up to ``count`` times on one colour scale, each above its cross-section w(z) at
-    x = x_injection (dashed line on the map), with the layer boundaries (default: the stored scene's)."""
+def width_maps(results: Results, count: int = 4, boundaries: Sequence[float] | None = None,
+               units: FigureUnits | None = None) -> Figure:
+    """Width maps [mm or in] at up to ``count`` times on one colour scale, each above its cross-section w(z) at
+    x = x_injection (dashed line on the map), with the layer boundaries [m] (default: the stored scene's)."""
     boundaries = layer_boundaries(results) if boundaries is None else boundaries
+    u = _units(results, units)
+    length, width = u.label("length"), u.label("width")
     snaps = [results.fracture_snapshots[i] for i in _picks(len(results.fracture_snapshots), count)]
     fig = Figure(figsize=(4 * len(snaps), 7), layout="constrained")
     axes = fig.subplots(2, len(snaps), squeeze=False)
     x_inj = injection_x(results)
-    limits = colour_range(*(snap.width * 1e3 for snap in snaps))
+    limits = colour_range(*(u("width", snap.width) for snap in snaps))
     for n, (top, bottom, snap) in enumerate(zip(axes[0], axes[1], snaps)):
-        _map(fig, top, snap.frame, snap.width * 1e3, "width [mm]", f"t = {_number(snap.time)} s", limits,
-             colourbar=n == len(snaps) - 1)
-        top.axvline(x_inj, color="w", lw=0.8, ls="--", label="cross-section (injection x)")
-        _layers_on_map(top, snap.frame, snap.width.shape, boundaries, legend=n == 0)
+        _map(fig, top, snap.frame, u("width", snap.width), f"width [{width}]", f"t = {_number(snap.time)} s",
+             limits, colourbar=n == len(snaps) - 1, units=u)
+        top.axvline(u("length", x_inj), color="w", lw=0.8, ls="--", label="cross-section (injection x)")
+        _layers_on_map(top, snap.frame, snap.width.shape, boundaries, legend=n == 0, units=u)
         if n == 0:
             _legend(top)
         x, z = snap.frame.centres(*snap.width.shape)
         column = int(np.argmin(np.abs(x - x_inj)))
-        bottom.plot(snap.width[:, column] * 1e3, z, "o-", ms=3, label="width")
-        draw_layers(bottom, boundaries, z[0] - snap.frame.dz / 2, z[-1] + snap.frame.dz / 2)
+        bottom.plot(u("width", snap.width[:, column]), u("length", z), "o-", ms=3, label="width")
+        draw_layers(bottom, _lengths(boundaries, u), u("length", z[0] - snap.frame.dz / 2),
+                    u("length", z[-1] + snap.frame.dz / 2))
         bottom.invert_yaxis()
-        bottom.set(xlabel=f"width at x = {x[column]:.3g} m [mm]", ylabel="depth z [m]",
-                   xlim=(limits[0], limits[1] * 1.05))
+        bottom.set(xlabel=f"width at x = {u('length', x[column]):.3g} {length} [{width}]",
+                   ylabel=f"depth z [{length}]", xlim=(limits[0], limits[1] * 1.05))
     return fig
 
 
-def footprints(results: Results, boundaries: Sequence[float] | None = None) -> Figure:
+def footprints(results: Results, boundaries: Sequence[float] | None = None,
+               units: FigureUnits | None = None) -> Figure:
     """Outline of the open region (width > 0) at every snapshot, coloured by time (the colour bar), with the
-    layer boundaries (default: the stored scene's)."""
+    layer boundaries [m] (default: the stored scene's)."""
     boundaries = layer_boundaries(results) if boundaries is None else boundaries
+    u = _units(results, units)
     fig = Figure(figsize=(6, 5), layout="constrained")
     ax = fig.subplots()
     snaps = list(results.fracture_snapshots)
@@ -169,25 +200,27 @@ def footprints(results: Results, boundaries: Sequence[float] | None = None) -> F
     for snap, colour in zip(snaps, colours):
         x, z = snap.frame.centres(*snap.width.shape)
         if min(snap.width.shape) >= 2 and (snap.width > 0).any():
-            ax.contour(x, z, (snap.width > 0).astype(float), levels=[0.5], colors=[colour])
+            ax.contour(u("length", x), u("length", z), (snap.width > 0).astype(float), levels=[0.5],
+                       colors=[colour])
     if snaps:
         lows, highs = zip(*((s.frame.z0 - s.frame.dz / 2, s.frame.z0 + (s.width.shape[0] - 0.5) * s.frame.dz)
                             for s in snaps))
-        draw_layers(ax, boundaries, min(lows), max(highs))
+        draw_layers(ax, _lengths(boundaries, u), u("length", min(lows)), u("length", max(highs)))
     ax.invert_yaxis()
-    ax.set(xlabel="x [m]", ylabel="depth z [m]", title="footprint (width > 0) over time", aspect="equal")
+    ax.set(**_xz_labels(u), title="footprint (width > 0) over time", aspect="equal")
     _legend(ax, Line2D([], [], color="k", lw=1, label="footprint outline (colour: time)"))
     _time_colourbar(fig, ax, results.fracture_snapshots.times)
     return fig
 
 
-def area_efficiency(results: Results) -> Figure:
-    """Open area [m^2] at the snapshots and fluid efficiency stored / injected from the balance."""
+def area_efficiency(results: Results, units: FigureUnits | None = None) -> Figure:
+    """Open area [m^2 or ft^2] at the snapshots and fluid efficiency stored / injected from the balance."""
+    u = _units(results, units)
     fig = Figure(figsize=(10, 4), layout="constrained")
     left, right = fig.subplots(1, 2)
     areas = [np.count_nonzero(s.width > 0) * s.frame.dx * s.frame.dz for s in results.fracture_snapshots]
-    left.plot(results.fracture_snapshots.times, areas, "o-")
-    left.set(xlabel="time [s]", ylabel="fracture area [m^2]", title="area")
+    left.plot(results.fracture_snapshots.times, u("area", areas), "o-")
+    left.set(xlabel="time [s]", ylabel=f"fracture area [{u.label('area')}]", title="area")
     b = results.fracture_balance
     if b:
         pumped = b["injected"] > 0
@@ -197,58 +230,64 @@ def area_efficiency(results: Results) -> Figure:
     return fig
 
 
-def pressure_history(results: Results) -> Figure:
-    """Net pressure at the injection cell [MPa] against time, linear and log-log (a Nolte-Smith plot: slope
+def pressure_history(results: Results, units: FigureUnits | None = None) -> Figure:
+    """Net pressure at the injection cell [MPa or psi] against time, linear and log-log (a Nolte-Smith plot: slope
     1/4 to 1/5 for a confined PKN-like fracture, negative for a radial or unconfined one), from the step
     history (/fracture/balance)."""
+    u = _units(results, units)
     b = results.fracture_balance
     fig = Figure(figsize=(10, 4), layout="constrained")
     left, right = fig.subplots(1, 2)
-    t, net = b["time"], b["net_pressure"] / 1e6
+    t, net = b["time"], u("pressure", b["net_pressure"])
+    label = f"net pressure at injection [{u.label('pressure')}]"
     left.plot(t, net)
-    left.set(xlabel="time [s]", ylabel="net pressure at injection [MPa]", title="net pressure")
+    left.set(xlabel="time [s]", ylabel=label, title="net pressure")
     positive = (t > 0) & (net > 0)
     right.loglog(t[positive], net[positive])
-    right.set(xlabel="time [s]", ylabel="net pressure at injection [MPa]", title="log-log (Nolte-Smith)")
+    right.set(xlabel="time [s]", ylabel=label, title="log-log (Nolte-Smith)")
     return fig
 
 
-def volume_balance(results: Results) -> Figure:
-    """Injected, stored and leaked volume [m^3] vs time; stored + leaked dotted (it should cover injected)."""
-    return _balance(results.fracture_balance, ("injected", "stored", "leaked"), "fluid volume balance")
+def volume_balance(results: Results, units: FigureUnits | None = None) -> Figure:
+    """Injected, stored and leaked volume [m^3 or bbl] vs time; stored + leaked dotted (it should cover
+    injected)."""
+    return _balance(results.fracture_balance, ("injected", "stored", "leaked"), "fluid volume balance",
+                    units=_units(results, units), kind="volume")
 
 
-def proppant_balance(results: Results) -> Figure:
+def proppant_balance(results: Results, units: FigureUnits | None = None) -> Figure:
     """Injected, in-domain, outflow and held-back (screened out at the inlet, when the file has it) solid volume
-    [m^3] vs time; their sum dotted (it should cover injected)."""
+    [m^3 or ft^3] vs time; their sum dotted (it should cover injected)."""
     names = ("injected", "in_domain", "outflow") + (("screened_out",) if "screened_out" in results.proppant_balance
                                                     else ())
     return _balance(results.proppant_balance, names, "proppant (solid) volume balance",
-                    {"in_domain": "in the domain", "screened_out": "held back at the inlet (screened out)"})
+                    {"in_domain": "in the domain", "screened_out": "held back at the inlet (screened out)"},
+                    units=_units(results, units), kind="solid_volume")
 
 
 def _balance(b: dict[str, np.ndarray], names: tuple[str, ...], title: str,
-             labels: dict[str, str] | None = None) -> Figure:
-    """``names[0]`` (what came in) and the others (where it went) vs time, with the others' sum dotted."""
+             labels: dict[str, str] | None = None, units: FigureUnits = SI, kind: str = "volume") -> Figure:
+    """``names[0]`` (what came in) and the others (where it went) vs time, with the others' sum dotted, as
+    ``kind`` in ``units``."""
     labels = labels or {}
     fig = Figure(figsize=(7, 4.5), layout="constrained")
     ax = fig.subplots()
     for name in names:
-        ax.plot(b["time"], b[name], label=labels.get(name, name))
-    ax.plot(b["time"], sum(b[name] for name in names[1:]), "k:",
+        ax.plot(b["time"], units(kind, b[name]), label=labels.get(name, name))
+    ax.plot(b["time"], units(kind, sum(b[name] for name in names[1:])), "k:",
             label=" + ".join(labels.get(name, name).split(" (")[0] for name in names[1:]))
-    ax.set(xlabel="time [s]", ylabel="volume [m^3]", title=title)
+    ax.set(xlabel="time [s]", ylabel=f"volume [{units.label(kind)}]", title=title)
     ax.legend()
     return fig
 
 
-def volume_fraction_map(snap: ProppantSnapshot, boundaries: Sequence[float] = ()) -> Figure:
-    """Proppant volume fraction on the grid, with the layer ``boundaries`` [m depth]."""
+def volume_fraction_map(snap: ProppantSnapshot, boundaries: Sequence[float] = (), units: FigureUnits = SI) -> Figure:
+    """Proppant volume fraction on the grid, with the layer ``boundaries`` [m depth], axes in ``units``."""
     fig = _domain_figure(snap.frame, snap.grid["volume_fraction"].shape)
     ax = fig.subplots()
     _map(fig, ax, snap.frame, snap.grid["volume_fraction"], "volume fraction [-]",
-         f"proppant volume fraction, t = {_number(snap.time)} s")
-    _layers_on_map(ax, snap.frame, snap.grid["volume_fraction"].shape, boundaries)
+         f"proppant volume fraction, t = {_number(snap.time)} s", units=units)
+    _layers_on_map(ax, snap.frame, snap.grid["volume_fraction"].shape, boundaries, units=units)
     _legend(ax)
     return fig
 
@@ -264,26 +303,30 @@ def _mean_speed(snap: ProppantSnapshot) -> np.ndarray:
     return np.where(count > 0, total / np.maximum(count, 1), np.nan)
 
 
-def parcel_speed_map(snap: ProppantSnapshot, boundaries: Sequence[float] = ()) -> Figure:
-    """Mean parcel speed [m/s] per grid cell (cells without parcels left blank), with the layer ``boundaries``."""
-    mean = _mean_speed(snap)
+def parcel_speed_map(snap: ProppantSnapshot, boundaries: Sequence[float] = (), units: FigureUnits = SI) -> Figure:
+    """Mean parcel speed [m/s or ft/s] per grid cell (cells without parcels left blank), with the layer
+    ``boundaries`` [m depth]."""
+    mean = units("speed", _mean_speed(snap))
     fig = _domain_figure(snap.frame, mean.shape)
     ax = fig.subplots()
-    _map(fig, ax, snap.frame, mean, "mean parcel speed [m/s]", f"parcel speed, t = {_number(snap.time)} s")
-    _layers_on_map(ax, snap.frame, mean.shape, boundaries)
+    _map(fig, ax, snap.frame, mean, f"mean parcel speed [{units.label('speed')}]",
+         f"parcel speed, t = {_number(snap.time)} s", units=units)
+    _layers_on_map(ax, snap.frame, mean.shape, boundaries, units=units)
     _legend(ax)
     return fig
 
 
-def proppant_maps(results: Results, count: int = 4, boundaries: Sequence[float] | None = None) -> Figure:
+def proppant_maps(results: Results, count: int = 4, boundaries: Sequence[float] | None = None,
+                  units: FigureUnits | None = None) -> Figure:
     """Volume fraction (top row) and mean parcel speed (bottom row) at up to ``count`` times (the paper's
     Fig. 14), each row on one colour scale; cells flagged ``bridging_risk`` are outlined in red where the file
     has that field; the layer boundaries (default: the stored scene's)."""
     boundaries = layer_boundaries(results) if boundaries is None else boundaries
+    u = _units(results, units)
     snaps = [results.proppant_snapshots[i] for i in _picks(len(results.proppant_snapshots), count)]
     fig = Figure(figsize=(4.5 * len(snaps), 6), layout="constrained")
     axes = fig.subplots(2, len(snaps), squeeze=False)
-    speeds = [_mean_speed(snap) for snap in snaps]
+    speeds = [u("speed", _mean_speed(snap)) for snap in snaps]
     fractions = colour_range(*(snap.grid["volume_fraction"] for snap in snaps))
     speed_range = colour_range(*speeds)
     outlined = [("bridging_risk" in snap.grid and snap.grid["bridging_risk"].any()
@@ -293,91 +336,99 @@ def proppant_maps(results: Results, count: int = 4, boundaries: Sequence[float] 
         last = n == len(snaps) - 1
         shape = snap.grid["volume_fraction"].shape
         _map(fig, top, snap.frame, snap.grid["volume_fraction"], "volume fraction [-]",
-             f"t = {_number(snap.time)} s", fractions, colourbar=last)
+             f"t = {_number(snap.time)} s", fractions, colourbar=last, units=u)
         if outlined[n]:
             x, z = snap.frame.centres(*snap.grid["width"].shape)
-            top.contour(x, z, snap.grid["bridging_risk"].astype(float), levels=[0.5], colors=["r"], linewidths=0.8)
-        _map(fig, bottom, snap.frame, speed, "mean parcel speed [m/s]", "", speed_range, colourbar=last)
+            top.contour(u("length", x), u("length", z), snap.grid["bridging_risk"].astype(float), levels=[0.5],
+                        colors=["r"], linewidths=0.8)
+        _map(fig, bottom, snap.frame, speed, f"mean parcel speed [{u.label('speed')}]", "", speed_range,
+             colourbar=last, units=u)
         for ax in (top, bottom):
-            _layers_on_map(ax, snap.frame, shape, boundaries, legend=n == 0)
+            _layers_on_map(ax, snap.frame, shape, boundaries, legend=n == 0, units=u)
     _legend(axes[0][0], *([bridging] if any(outlined) else []))  # one legend for the row
     return fig
 
 
-def streamlines(snap: ProppantSnapshot, boundaries: Sequence[float] = ()) -> Figure:
+def streamlines(snap: ProppantSnapshot, boundaries: Sequence[float] = (), units: FigureUnits = SI) -> Figure:
     """Streamlines of the fluid velocity (face values averaged to the cell centres, zero in closed cells)
-    over the width map [mm], coloured by speed (the paper's Fig. 13c, 15j-l)."""
+    over the width map [mm or in], coloured by speed (the paper's Fig. 13c, 15j-l)."""
     g, f = snap.grid, snap.frame
     width = np.asarray(g["width"])
     u = 0.5 * (g["fluid_u"][:, :-1] + g["fluid_u"][:, 1:])
     v = 0.5 * (g["fluid_v"][:-1, :] + g["fluid_v"][1:, :])
-    u, v = np.where(width > 0, u, 0.0), np.where(width > 0, v, 0.0)
+    u, v = units("speed", np.where(width > 0, u, 0.0)), units("speed", np.where(width > 0, v, 0.0))
     fig = _domain_figure(f, width.shape)
     ax = fig.subplots()
-    _map(fig, ax, f, np.where(width > 0, width * 1e3, np.nan), "width [mm]",
-         f"fluid streamlines, t = {_number(snap.time)} s")
-    _layers_on_map(ax, f, width.shape, boundaries)
+    _map(fig, ax, f, np.where(width > 0, units("width", width), np.nan), f"width [{units.label('width')}]",
+         f"fluid streamlines, t = {_number(snap.time)} s", units=units)
+    _layers_on_map(ax, f, width.shape, boundaries, units=units)
     x, z = f.centres(*width.shape)
+    x, z, dx, dz = units("length", x), units("length", z), units("length", f.dx), units("length", f.dz)
     if min(width.shape) >= 2 and np.any(u) | np.any(v):
         lines = ax.streamplot(x, z, u, v, color=np.hypot(u, v), cmap="magma", density=1.2, linewidth=0.7)
-        fig.colorbar(lines.lines, ax=ax, label="fluid speed [m/s]")
-    ax.set(xlim=(x[0] - f.dx / 2, x[-1] + f.dx / 2), ylim=(z[-1] + f.dz / 2, z[0] - f.dz / 2))
+        fig.colorbar(lines.lines, ax=ax, label=f"fluid speed [{units.label('speed')}]")
+    ax.set(xlim=(x[0] - dx / 2, x[-1] + dx / 2), ylim=(z[-1] + dz / 2, z[0] - dz / 2))
     _legend(ax)
     return fig
 
 
-def speed_probability(results: Results, times: tuple[float, ...] | None = None) -> Figure:
+def speed_probability(results: Results, times: tuple[float, ...] | None = None,
+                      units: FigureUnits | None = None) -> Figure:
     """Cumulative probability of the parcel speed |u_p| at the snapshots nearest ``times`` (the paper's
     Fig. 16; default 1260 / 1800 / 3600 s, or the same fractions of a shorter slurry period,
     :func:`hfgpu.propped.results_times`), with the packed-parcel threshold of :mod:`hfgpu.propped` dotted."""
     from ..propped import PACKED_SPEED, packed_fraction, results_times
 
     times = results_times(results) if times is None else times
+    u = _units(results, units)
+    speed_unit, threshold = u.label("speed"), u("speed", PACKED_SPEED)
     fig = Figure(figsize=(4.5 * len(times), 4), layout="constrained")
     for ax, t in zip(fig.subplots(1, len(times), squeeze=False)[0], times):
         snap = results.proppant_snapshots.at(t)
-        speed = np.sort(np.hypot(snap.parcels["u"], snap.parcels["v"]))
+        speed = u("speed", np.sort(np.hypot(snap.parcels["u"], snap.parcels["v"])))
         if speed.size:
             ax.plot(speed, (np.arange(speed.size) + 0.5) / speed.size, ".", ms=2, label="parcels")
-        ax.axvline(PACKED_SPEED, color="k", ls=":", lw=0.8, label=f"packed below {PACKED_SPEED:g} m/s")
+        ax.axvline(threshold, color="k", ls=":", lw=0.8,
+                   label=f"packed below {threshold:{'.3g' if u.field else 'g'}} {speed_unit}")
         packed = packed_fraction(snap.parcels) if speed.size else math.nan
-        ax.set(xlabel="|u_p| [m/s]", ylabel="cumulative probability [-]", ylim=(0, 1),
+        ax.set(xlabel=f"|u_p| [{speed_unit}]", ylabel="cumulative probability [-]", ylim=(0, 1),
                title=f"t = {_number(snap.time)} s, " + (f"packed {packed:.2f}" if math.isfinite(packed)
                                                          else "no parcels"))
         _legend(ax)
     return fig
 
 
-def propped_area(results: Results) -> Figure:
-    """Fracture area (fracture snapshots), created and propped area (proppant grid) vs time (Fig. 18)."""
+def propped_area(results: Results, units: FigureUnits | None = None) -> Figure:
+    """Fracture area (fracture snapshots), created and propped area (proppant grid) [m^2 or ft^2] vs time
+    (Fig. 18)."""
     from ..propped import area_history, fracture_area_history
 
+    u = _units(results, units)
     fig = Figure(figsize=(7, 4.5), layout="constrained")
     ax = fig.subplots()
     frac = fracture_area_history(results)
-    ax.plot(frac["time"], frac["area"], label="fracture area")
+    ax.plot(frac["time"], u("area", frac["area"]), label="fracture area")
     areas = area_history(results)
-    ax.plot(areas["time"], areas["created"], "--", label="open area (proppant grid)")
-    ax.plot(areas["time"], areas["propped"], "o-", ms=3, label="propped area")
-    ax.set(xlabel="time [s]", ylabel="area [m^2]", title="created and propped area")
+    ax.plot(areas["time"], u("area", areas["created"]), "--", label="open area (proppant grid)")
+    ax.plot(areas["time"], u("area", areas["propped"]), "o-", ms=3, label="propped area")
+    ax.set(xlabel="time [s]", ylabel=f"area [{u.label('area')}]", title="created and propped area")
     ax.legend()
     return fig
 
 
-def parcels_by_radius(snap: ProppantSnapshot, boundaries: Sequence[float] = ()) -> Figure:
-    """Parcel positions coloured by particle radius [um]."""
+def parcels_by_radius(snap: ProppantSnapshot, boundaries: Sequence[float] = (), units: FigureUnits = SI) -> Figure:
+    """Parcel positions coloured by particle radius [um or in]."""
     shape = snap.grid["volume_fraction"].shape
     fig = _domain_figure(snap.frame, shape)
     ax = fig.subplots()
-    x = snap.parcels["x"]
-    points = ax.scatter(x, snap.parcels["z"], c=snap.parcels["radius"] * 1e6, s=min(4.0, 2e4 / max(x.size, 1)),
-                        linewidths=0)
-    fig.colorbar(points, ax=ax, label="radius [um]")
-    left, right, bottom, top = _extent(snap.frame, shape)
-    ax.set(xlim=(left, right), ylim=(bottom, top), xlabel="x [m]", ylabel="depth z [m]",
-           aspect=_aspect(snap.frame, shape),
+    x = units("length", snap.parcels["x"])
+    points = ax.scatter(x, units("length", snap.parcels["z"]), c=units("radius", snap.parcels["radius"]),
+                        s=min(4.0, 2e4 / max(x.size, 1)), linewidths=0)
+    fig.colorbar(points, ax=ax, label=f"radius [{units.label('radius')}]")
+    left, right, bottom, top = _extent(snap.frame, shape, units)
+    ax.set(xlim=(left, right), ylim=(bottom, top), **_xz_labels(units), aspect=_aspect(snap.frame, shape),
            title=f"parcels by radius, t = {_number(snap.time)} s")
-    _layers_on_map(ax, snap.frame, shape, boundaries)
+    _layers_on_map(ax, snap.frame, shape, boundaries, units=units)
     _legend(ax)
     return fig
 
@@ -399,7 +450,8 @@ def _time_colourbar(fig: Figure, ax, times: np.ndarray) -> None:
 
 def closure_maps(closure, system: str = "SI", boundaries: Sequence[float] = ()) -> Figure:
     """Propped width and conductivity after closure (:mod:`hfgpu.closure`), in ``system``'s units ("SI" or
-    "field"; the axes stay in m), with the layer ``boundaries``."""
+    "field", the axes in m or ft; the values in :mod:`hfgpu.closure.display`'s units), with the layer
+    ``boundaries`` [m depth]."""
     from ..closure.display import in_units, unit_label
 
     shape = closure.fields["propped_width"].shape
@@ -409,8 +461,8 @@ def closure_maps(closure, system: str = "SI", boundaries: Sequence[float] = ()) 
                                ("propped width after closure", "conductivity after closure")):
         values = np.where(closure.fields["propped"] > 0, in_units(name, closure.fields[name], system), np.nan)
         _map(fig, ax, closure.frame, values, f"{name.replace('_', ' ')} [{unit_label(name, system)}]",
-             f"{title} (t = {_number(closure.scalars.get('time', math.nan))} s)")
-        _layers_on_map(ax, closure.frame, shape, boundaries)
+             f"{title} (t = {_number(closure.scalars.get('time', math.nan))} s)", units=FigureUnits(system))
+        _layers_on_map(ax, closure.frame, shape, boundaries, units=FigureUnits(system))
         _legend(ax)
     return fig
 
@@ -452,18 +504,19 @@ def interface_heights(results: Results) -> dict[str, np.ndarray]:
             "bed_level": bed_level}
 
 
-def column_interfaces(results: Results) -> Figure:
-    """Top of the suspension and bed top [m above the bottom] against time in a settling column
+def column_interfaces(results: Results, units: FigureUnits | None = None) -> Figure:
+    """Top of the suspension and bed top [m or ft above the bottom] against time in a settling column
     (:func:`interface_heights`)."""
+    u = _units(results, units)
     h = interface_heights(results)
     snap = results.proppant_snapshots[0]
-    height = snap.grid["volume_fraction"].shape[0] * snap.frame.dz
+    height = u("length", snap.grid["volume_fraction"].shape[0] * snap.frame.dz)
     fig = Figure(figsize=(7, 4.5), layout="constrained")
     ax = fig.subplots()
-    ax.plot(h["time"], h["suspension_top"], "o-", ms=3,
+    ax.plot(h["time"], u("length", h["suspension_top"]), "o-", ms=3,
             label=f"top of the suspension (theta_p = {h['suspension_level']:.3g})")
-    ax.plot(h["time"], h["bed_top"], "s-", ms=3, label=f"bed top (theta_p = {h['bed_level']:.3g})")
-    ax.set(xlabel="time [s]", ylabel="height above the bottom [m]", ylim=(0, height * 1.02),
+    ax.plot(h["time"], u("length", h["bed_top"]), "s-", ms=3, label=f"bed top (theta_p = {h['bed_level']:.3g})")
+    ax.set(xlabel="time [s]", ylabel=f"height above the bottom [{u.label('length')}]", ylim=(0, height * 1.02),
            title="settling column: interface heights")
     ax.legend()
     return fig
@@ -480,35 +533,35 @@ def _closure(results: Results):
         return None
 
 
-def figures(results: Results) -> dict[str, Figure]:
-    """Every figure the results support, by file stem."""
+def figures(results: Results, units: FigureUnits | None = None) -> dict[str, Figure]:
+    """Every figure the results support, by file stem, in ``units`` (default: the results' ``[output] units``)."""
     out: dict[str, Figure] = {}
     layers = layer_boundaries(results)
+    u = _units(results, units)
     if len(results.fracture_snapshots):
-        out.update(fracture_width=width_maps(results, boundaries=layers),
-                   fracture_footprints=footprints(results, boundaries=layers),
-                   fracture_area_efficiency=area_efficiency(results))
+        out.update(fracture_width=width_maps(results, boundaries=layers, units=u),
+                   fracture_footprints=footprints(results, boundaries=layers, units=u),
+                   fracture_area_efficiency=area_efficiency(results, units=u))
     if results.fracture_balance:
-        out["fracture_volume_balance"] = volume_balance(results)
+        out["fracture_volume_balance"] = volume_balance(results, units=u)
         if np.isfinite(results.fracture_balance.get("net_pressure", np.nan)).any():
-            out["pressure_history"] = pressure_history(results)
+            out["pressure_history"] = pressure_history(results, units=u)
     if len(results.proppant_snapshots):
         last = results.proppant_snapshots[-1]
-        out.update(proppant_volume_fraction=volume_fraction_map(last, layers),
-                   proppant_speed=parcel_speed_map(last, layers), proppant_radius=parcels_by_radius(last, layers))
+        out.update(proppant_volume_fraction=volume_fraction_map(last, layers, u),
+                   proppant_speed=parcel_speed_map(last, layers, u), proppant_radius=parcels_by_radius(last, layers, u))
         closure = _closure(results)
         if closure is not None:
-            from .export import output_units
-
-            out["closure_maps"] = closure_maps(closure, output_units(results), layers)
+            out["closure_maps"] = closure_maps(closure, u.system, layers)
     if results.proppant_balance:
-        out["proppant_volume_balance"] = proppant_balance(results)
+        out["proppant_volume_balance"] = proppant_balance(results, units=u)
     if is_column(results):
-        out["proppant_interfaces"] = column_interfaces(results)
+        out["proppant_interfaces"] = column_interfaces(results, units=u)
     if len(results.fracture_snapshots) and len(results.proppant_snapshots):  # a coupled run
-        out.update(proppant_maps=proppant_maps(results, boundaries=layers),
-                   proppant_streamlines=streamlines(results.proppant_snapshots[-1], layers),
-                   proppant_speed_probability=speed_probability(results), propped_area=propped_area(results))
+        out.update(proppant_maps=proppant_maps(results, boundaries=layers, units=u),
+                   proppant_streamlines=streamlines(results.proppant_snapshots[-1], layers, u),
+                   proppant_speed_probability=speed_probability(results, units=u),
+                   propped_area=propped_area(results, units=u))
     return out
 
 
