@@ -8,7 +8,8 @@ physics lacks it, e.g. proppant metrics of a fracture-only scene):
 * ``propped_area`` [m^2], ``propped_fraction`` [-]: hfgpu.propped.propped_summary at the last proppant snapshot
   (one packed grain layer; the fraction is of that grid's created area);
 * ``fracture_height``, ``fracture_length`` [m]: the final ``height`` and ``length``;
-* ``net_pressure_end`` [Pa]: ``p_inlet`` - sigma_min(injection depth) at the end of the fracture run;
+* ``net_pressure_end`` [Pa]: the summary's ``net_pressure_end``, the last fracture step's net pressure at the
+  injection cell (/fracture/balance);
 * ``efficiency`` [-]: the summary's fluid efficiency, stored / injected volume;
 * ``screened_out`` [-]: 1 when proppant was held back at the inlets (``proppant_screened_out`` > 0), else 0.
 
@@ -16,8 +17,6 @@ physics lacks it, e.g. proppant metrics of a fracture-only scene):
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
@@ -38,11 +37,9 @@ def member_metrics(results) -> dict[str, float]:
 
     out = {"created_area": fracture("area"), "fracture_height": fracture("height"),
            "fracture_length": fracture("length"), "efficiency": float(s.get("efficiency", NAN)),
-           "net_pressure_end": NAN, "propped_area": NAN, "propped_fraction": NAN, "screened_out": NAN}
+           "net_pressure_end": float(s.get("net_pressure_end", NAN)), "propped_area": NAN, "propped_fraction": NAN,
+           "screened_out": NAN}
     scene = results.scene
-    p_inlet = fracture("p_inlet")
-    if scene.rock is not None and scene.injection is not None and not math.isnan(p_inlet):
-        out["net_pressure_end"] = p_inlet - float(scene.rock.min_stress_at(np.array([scene.injection.depth]))[0])
     if len(results.proppant_snapshots):
         from ..propped import propped_summary
 
