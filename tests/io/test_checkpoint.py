@@ -219,14 +219,13 @@ def test_coupled_run_resumes_in_either_phase(after, phase, reference, tmp_path, 
         assert got[key] == ref[key], key
 
 
-def test_killed_cli_run_keeps_its_snapshots_and_resumes(reference, tmp_path):
-    """``hfgpu run`` killed with SIGKILL once its file holds a checkpoint: the file opens, every snapshot in it is
-    whole, and ``hfgpu run --resume`` ends it as the uninterrupted run."""
+def _signalled_once_checkpointed(tmp_path: Path, path: Path, number: int) -> tuple[list[str], int, str]:
+    """Start ``hfgpu run`` on the fracture scene (checkpoints every 3 s) into ``path``, send it signal ``number``
+    once the file holds a checkpoint; (the command, its exit code, its stderr)."""
     scene = tmp_path / "scene.toml"
     scene.write_text(FRACTURE.replace('checkpoint_every = "7 s"', 'checkpoint_every = "3 s"'))
-    path = tmp_path / "killed.h5"
     command = [sys.executable, "-m", "hfgpu.cli", "run", str(scene), "--out", str(path), "--no-progress"]
-    proc = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120.0
     try:
         while proc.poll() is None and time.monotonic() < deadline:
@@ -237,9 +236,17 @@ def test_killed_cli_run_keeps_its_snapshots_and_resumes(reference, tmp_path):
                 pass  # not created yet, or caught in the middle of a write
             time.sleep(0.01)
     finally:
-        proc.send_signal(signal.SIGKILL)
-        proc.communicate()
-    assert proc.returncode == -signal.SIGKILL, "the run ended before it could be killed"
+        proc.send_signal(number)
+        _, stderr = proc.communicate(timeout=60)
+    return command, proc.returncode, stderr
+
+
+def test_killed_cli_run_keeps_its_snapshots_and_resumes(reference, tmp_path):
+    """``hfgpu run`` killed with SIGKILL once its file holds a checkpoint: the file opens, every snapshot in it is
+    whole, and ``hfgpu run --resume`` ends it as the uninterrupted run."""
+    path = tmp_path / "killed.h5"
+    command, returncode, _ = _signalled_once_checkpointed(tmp_path, path, signal.SIGKILL)
+    assert returncode == -signal.SIGKILL, "the run ended before it could be killed"
     cut = open_results(path)
     assert cut.status == "running" and cut.checkpoint_time is not None
     for snap in cut.fracture_snapshots:  # every snapshot the file lists reads whole
@@ -257,24 +264,9 @@ def test_sigterm_and_sighup_end_the_run_as_interrupted_and_resumable(stop, refer
     checkpoint ends as Ctrl-C does: exit 128 + the signal, one line, status "interrupted" with a summary, and
     ``--resume`` ends it as the uninterrupted run."""
     number = getattr(signal, stop)
-    scene = tmp_path / "scene.toml"
-    scene.write_text(FRACTURE.replace('checkpoint_every = "7 s"', 'checkpoint_every = "3 s"'))
     path = tmp_path / "stopped.h5"
-    command = [sys.executable, "-m", "hfgpu.cli", "run", str(scene), "--out", str(path), "--no-progress"]
-    proc = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 120.0
-    try:
-        while proc.poll() is None and time.monotonic() < deadline:
-            try:
-                if open_results(path).checkpoint_time is not None:
-                    break
-            except (HfgpuError, OSError, KeyError):
-                pass
-            time.sleep(0.01)
-    finally:
-        proc.send_signal(number)
-        _, stderr = proc.communicate(timeout=60)
-    assert proc.returncode == 128 + number, stderr
+    command, returncode, stderr = _signalled_once_checkpointed(tmp_path, path, number)
+    assert returncode == 128 + number, stderr
     assert stderr.strip().splitlines()[-1] == f"hfgpu run: interrupted ({stop})"
     cut = open_results(path)
     assert cut.status == "interrupted" and cut.summary["interrupted_by"] == stop
