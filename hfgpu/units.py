@@ -180,13 +180,14 @@ def majority_system(data: object) -> str:
     return "field" if counts["field"] > counts["SI"] else "SI"
 
 
-#: kind: (SI display unit, field display unit), as pint spells them: the units of the summary, ``check`` and the
-#: pump-schedule table (the results file stays SI).
+#: kind: (SI display unit, field display unit), as pint spells them: the units of the summary, ``check``, the
+#: pump-schedule table and the figures (the results file stays SI).
 DISPLAY_UNITS = {
     "length": ("m", "ft"), "depth": ("m", "ft"), "width": ("mm", "in"), "area": ("m**2", "ft**2"),
     "pressure": ("MPa", "psi"), "volume": ("m**3", "bbl"), "solid_volume": ("m**3", "ft**3"),
     "mass": ("kg", "lb"), "rate": ("m**3/min", "bbl/min"), "concentration": ("kg/m**3", "ppa"),
     "viscosity": ("mPa*s", "cP"), "time": ("s", "s"), "density": ("kg/m**3", "lb/gal"),
+    "radius": ("um", "in"), "speed": ("m/s", "ft/s"),
 }
 
 
@@ -197,10 +198,16 @@ def display_unit(kind: str, system: str) -> str:
 
 def in_display_units(value: float, kind: str, system: str) -> float:
     """An SI ``value`` of ``kind`` in the display unit of ``system``."""
-    return convert(value, SI_UNITS.get(kind, _DISPLAY_SI.get(kind, "")), DISPLAY_UNITS[kind][SYSTEMS.index(system)])
+    return convert(value, stored_unit(kind), DISPLAY_UNITS[kind][SYSTEMS.index(system)])
 
 
-_DISPLAY_SI = {"depth": "m", "width": "m", "area": "m**2", "solid_volume": "m**3", "mass": "kg"}
+def stored_unit(kind: str) -> str:
+    """The SI unit a value of display ``kind`` is stored in (scenes and results files)."""
+    return SI_UNITS.get(kind, _DISPLAY_SI.get(kind, ""))
+
+
+_DISPLAY_SI = {"depth": "m", "width": "m", "area": "m**2", "solid_volume": "m**3", "mass": "kg", "radius": "m",
+               "speed": "m/s"}
 
 
 def format_number(value: float, digits: int = 4) -> str:

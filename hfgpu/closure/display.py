@@ -6,9 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..units import convert
+from ..units import SYSTEMS, convert
 
-SYSTEMS = ("SI", "field")
 #: quantity kind: (SI unit, field unit), as pint spells them.
 KINDS = {"length": ("m", "ft"), "width": ("m", "in"), "conductivity": ("m**3", "md*ft"),
          "permeability": ("m**2", "md"), "stress": ("Pa", "psi"), "area": ("m**2", "ft**2"), "time": ("s", "s"),

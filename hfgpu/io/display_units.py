@@ -2,8 +2,8 @@
 :func:`hfgpu.io.export.output_units`). SI figures keep their units (x and depth in m, widths in mm, pressures in
 MPa, areas in m^2, volumes in m^3, speeds in m/s, grain radii in um); field figures draw lengths and depths in ft,
 widths and grain radii in in, pressures in psi, areas in ft^2, fluid volumes in bbl, solid volumes in ft^3 and
-speeds in ft/s. Times stay in s and dimensionless numbers unchanged in both. Conversions by pint
-(:func:`hfgpu.units.convert`); the results file stays SI."""
+speeds in ft/s. Times stay in s and dimensionless numbers unchanged in both. The units are those of the summary
+and ``check`` (:data:`hfgpu.units.DISPLAY_UNITS`), converted by pint; the results file stays SI."""
 
 from __future__ import annotations
 
@@ -12,22 +12,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..units import SYSTEMS, convert
-
-#: kind: (unit stored in the results file, figure unit in SI, figure unit in field units), as pint spells them.
-FIGURE_UNITS = {
-    "length": ("m", "m", "ft"), "width": ("m", "mm", "in"), "radius": ("m", "um", "in"),
-    "pressure": ("Pa", "MPa", "psi"), "area": ("m**2", "m**2", "ft**2"), "volume": ("m**3", "m**3", "bbl"),
-    "solid_volume": ("m**3", "m**3", "ft**3"), "speed": ("m/s", "m/s", "ft/s"), "time": ("s", "s", "s"),
-}
+from ..units import DISPLAY_UNITS, SYSTEMS, convert, display_unit, stored_unit
 
 
 @functools.lru_cache(maxsize=None)
 def _scale(kind: str, system: str) -> tuple[str, float]:
-    """("*" or "/", number): how an SI value of ``kind`` becomes its ``system`` figure value. A factor below one is
-    applied as a division by its (exact) inverse, so SI figures draw the very numbers they did (Pa / 1e6)."""
-    stored, *shown = FIGURE_UNITS[kind]
-    target = shown[SYSTEMS.index(system)]
+    """("*" or "/", number): how an SI value of ``kind`` becomes its ``system`` display value
+    (:data:`hfgpu.units.DISPLAY_UNITS`). A factor below one is applied as a division by its (exact) inverse, so SI
+    figures draw the very numbers they did (Pa / 1e6)."""
+    stored = stored_unit(kind)
+    target = DISPLAY_UNITS[kind][SYSTEMS.index(system)]
     if target == stored:
         return "*", 1.0
     factor = convert(1.0, stored, target)
@@ -54,7 +48,7 @@ class FigureUnits:
 
     def label(self, kind: str) -> str:
         """The figure unit of ``kind`` as text ("m**2" written "m^2")."""
-        return FIGURE_UNITS[kind][1 + SYSTEMS.index(self.system)].replace("**", "^").replace("*", " ")
+        return display_unit(kind, self.system)
 
     @property
     def field(self) -> bool:
