@@ -95,15 +95,18 @@ def initial_time(e_prime: float, mu_prime: float, k_prime: float, c_prime: float
                  radius: float) -> tuple[float, float]:
     """(t0, a): the latest time at which a radial vertex solution reaches ``radius`` and its exponent a
     (R ~ t^a). Vertices (REFERENCE.md 1.1): M R = 0.6955 (E' Q^3 t^4 / mu')^(1/9); K R = 0.8546
-    (E' Q t / K')^(2/5); Mt = Kt R = 0.4502 (Q^2 t / C'^2)^(1/4)."""
-    times = [((radius / 0.6955) ** 9 * mu_prime / (e_prime * q**3)) ** 0.25, ]
-    powers = [4.0 / 9.0]
-    if k_prime > 0.0:
-        times.append((radius / 0.8546) ** 2.5 * k_prime / (e_prime * q))
-        powers.append(0.4)
-    if c_prime > 0.0:
-        times.append((radius / 0.4502) ** 4 * c_prime**2 / q**2)
-        powers.append(0.25)
+    (E' Q t / K')^(2/5); Mt = Kt R = 0.4502 (Q^2 t / C'^2)^(1/4). In float64 arithmetic: an absurd rate
+    (Q^3 past 1e308) gives t0 = 0, not an OverflowError from Python's float power."""
+    q = np.float64(q)
+    with np.errstate(over="ignore"):
+        times = [((radius / 0.6955) ** 9 * mu_prime / (e_prime * q**3)) ** 0.25, ]
+        powers = [4.0 / 9.0]
+        if k_prime > 0.0:
+            times.append((radius / 0.8546) ** 2.5 * k_prime / (e_prime * q))
+            powers.append(0.4)
+        if c_prime > 0.0:
+            times.append((radius / 0.4502) ** 4 * c_prime**2 / q**2)
+            powers.append(0.25)
     i = int(np.argmax(times))
     return float(times[i]), powers[i]
 

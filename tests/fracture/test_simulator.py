@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from hfgpu.errors import SceneError, SimulationError
-from hfgpu.fracture.simulator import simulate
+from hfgpu.fracture.simulator import initial_time, simulate
 from hfgpu.records import MemorySink
 from hfgpu.scene import load_scene
 
@@ -108,6 +108,15 @@ def test_bad_input_is_rejected_before_work_starts():
         load_scene(scene_text(fracture='[fracture]\nfront_tracking = "level set"'))
     with pytest.raises(SceneError, match="fracture.initial_radius_cells"):
         simulate(scene(end_time="0.001 s", cell="1 m"), MemorySink())
+
+
+def test_start_time_of_an_absurd_rate_is_zero_not_an_overflow():
+    """initial_time in float64: Q^3 past 1e308 (a bare-number rate of 5.6e102 m^3/s, found by the CLI fuzz test)
+    gives t0 = 0 for the M vertex; an ordinary rate gives the M vertex's closed-form time."""
+    t0, power = initial_time(3e10, 12.0, 0.0, 0.0, 5.6e102, 1.0)
+    assert t0 == 0.0 and power == pytest.approx(4.0 / 9.0)
+    t0, _ = initial_time(3e10, 12.0, 0.0, 0.0, 1e-2, 1.0)
+    assert 0.6955 * (3e10 * 1e-6 * t0**4 / 12.0) ** (1.0 / 9.0) == pytest.approx(1.0, rel=1e-12)
 
 
 def test_newton_failure_raises_simulation_error_with_time_cell_and_residual():
