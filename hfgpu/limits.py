@@ -29,6 +29,10 @@ from .errors import SceneError
 #: Measured: 434 B (peak resident memory of a 1.02e6-parcel Taichi run less a 1e4-parcel one, per parcel,
 #: docs/stability.md); about twice that leaves room for the copies made when parcels are appended.
 BYTES_PER_PARCEL = 1024
+#: Host memory one proppant grid cell costs [bytes]: the grid's fields, the fluid state and the SIMPLE matrices.
+#: Measured: ~1.3 kB (peak resident memory of a 1e5-cell box after one step less a 1e4-cell one, per cell, less
+#: their parcels); rounded up as BYTES_PER_PARCEL is.
+BYTES_PER_CELL = 2048
 
 
 def physical_memory() -> int:
@@ -45,7 +49,10 @@ def check_limits(scene, memory: int | None = None) -> None:
     if scene.proppant is None:
         return
     _check_packing(scene)
-    _check_parcel_memory(scene, physical_memory() if memory is None else memory)
+    memory = physical_memory() if memory is None else memory
+    if memory > 0:  # 0: the platform does not report it
+        grid = _check_grid_memory(scene, memory)  # before the parcel estimate, which builds the grid
+        _check_parcel_memory(scene, memory - grid)
 
 
 def check_engine_start(scene) -> None:
@@ -134,10 +141,30 @@ def estimated_parcels(scene) -> float | None:
     return total
 
 
+def grid_cells(scene) -> float:
+    """Cells of a box or slot scene's proppant grid, round(length / dx) x round(height / dz) (build_grid) without
+    building it; 0 for other geometries (a coupled grid is known only once the fracture has run; a width file's
+    grid is already read)."""
+    geometry = scene.proppant.geometry
+    if geometry.kind not in ("box", "slot"):
+        return 0.0
+    return max(1.0, round(geometry.length / scene.mesh.dx)) * max(1.0, round(geometry.height / scene.mesh.dz))
+
+
+def _check_grid_memory(scene, memory: int) -> int:
+    """grid_cells x BYTES_PER_CELL must fit in ``memory``; returns those bytes."""
+    geometry, cells = scene.proppant.geometry, grid_cells(scene)
+    most = memory / BYTES_PER_CELL
+    if cells > most:
+        raise SceneError("mesh.cell_size", f"{scene.mesh.dx:g} x {scene.mesh.dz:g} m",
+                         f"the {geometry.length:g} x {geometry.height:g} m {geometry.kind} would have ~{cells:.3g} "
+                         f"cells; at most {most:.3g} fit in this machine's {memory / 2**30:.3g} GiB "
+                         f"({BYTES_PER_CELL} bytes per cell): use larger cells or a smaller geometry")
+    return int(cells * BYTES_PER_CELL)
+
+
 def _check_parcel_memory(scene, memory: int) -> None:
-    """Estimated parcels x BYTES_PER_PARCEL must fit in ``memory``."""
-    if memory <= 0:
-        return
+    """Estimated parcels x BYTES_PER_PARCEL must fit in ``memory`` (what the grid leaves)."""
     count = estimated_parcels(scene)
     if count is None:
         return

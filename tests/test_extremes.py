@@ -7,13 +7,15 @@ docs/stability.md; a few representative cases run by default, the rest under ``-
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
 from hfgpu import SceneError, load_scene, run
-from hfgpu.limits import BYTES_PER_PARCEL, check_limits, estimated_parcels, physical_memory
+from hfgpu.limits import (BYTES_PER_CELL, BYTES_PER_PARCEL, check_limits, estimated_parcels, grid_cells,
+                          physical_memory)
 
 from .extremes_checks import (Outcome, barrier_layers, check_fracture, check_proppant, coupled_text,
                               fracture_text, mean_position, proppant_text, run_case)
@@ -272,6 +274,17 @@ def test_parcels_beyond_memory_are_refused_before_any_work(tmp_path):
     assert not out.exists()
 
 
+def test_grid_beyond_memory_is_refused_before_it_is_built():
+    """A box of ~4e8 cells (the CLI fuzz test's 8200 km slot) is refused naming the cell size, before the parcel
+    estimate would allocate it."""
+    scene = load_scene(proppant_text(end_time="1 s"))
+    huge = scene.replace(proppant=dataclasses.replace(scene.proppant, geometry=dataclasses.replace(
+        scene.proppant.geometry, length=8.2e6)))
+    with pytest.raises(SceneError, match=r"mesh\.cell_size.*cells; at most"):
+        check_limits(huge, memory=2**34)
+    check_limits(scene, memory=2**34)
+
+
 def test_parcel_estimate_counts_what_a_run_makes(tmp_path):
     """The estimate behind the memory limit against the parcels a short run actually created."""
     text = proppant_text(end_time="1 s", outlet=False)
@@ -280,6 +293,7 @@ def test_parcel_estimate_counts_what_a_run_makes(tmp_path):
     outcome = run_case(text, tmp_path / "r.h5")
     made = check_proppant(outcome)["parcels"]
     assert made == pytest.approx(estimate, rel=0.05, abs=2)
-    check_limits(scene, memory=int(2 * estimate * BYTES_PER_PARCEL))
+    grid = int(grid_cells(scene) * BYTES_PER_CELL)  # the grid's share of the memory comes first
+    check_limits(scene, memory=grid + int(2 * estimate * BYTES_PER_PARCEL))
     with pytest.raises(SceneError, match="mppic.parcels_per_cell"):
-        check_limits(scene, memory=int(0.5 * estimate * BYTES_PER_PARCEL))
+        check_limits(scene, memory=grid + int(0.5 * estimate * BYTES_PER_PARCEL))
