@@ -4,6 +4,7 @@ Python API::
 
     import hfgpu
     scene = hfgpu.load_scene("scene.toml")
+    finer = hfgpu.edit_scene(scene, {"coupling.cell_size": "2.5 m"})   # keys changed as text (hfgpu.scene_text)
     hfgpu.run(scene, "results.h5")
     results = hfgpu.open_results("results.h5")
     rows = hfgpu.sweep("study.toml", "study")   # an ensemble on Dask (docs/ensembles.md)
@@ -11,6 +12,7 @@ Python API::
 
 from .errors import HfgpuError, SceneError, SimulationError
 from .scene import Scene, load_scene
+from .scene_text import edit_scene
 
 __version__ = "0.1.0"
 
@@ -37,4 +39,5 @@ def sweep(sweep_file, out, **options):
     return _sweep(sweep_file, out, **options)
 
 
-__all__ = ["HfgpuError", "Scene", "SceneError", "SimulationError", "load_scene", "open_results", "run", "sweep"]
+__all__ = ["HfgpuError", "Scene", "SceneError", "SimulationError", "edit_scene", "load_scene", "open_results", "run",
+           "sweep"]

@@ -14,6 +14,7 @@ import importlib
 import math
 import signal
 import sys
+import warnings
 from pathlib import Path
 from typing import Any, Callable
 
@@ -53,6 +54,23 @@ class FanOut:
         return forward
 
 
+def warn_edited(scene: Scene) -> None:
+    """Warn when the scene's values are not those of its TOML text (changed with ``Scene.replace`` after it was
+    read): the results file stores that text under ``/scene``, which would then not describe the run."""
+    from .scene import load_scene
+
+    if not scene.source:
+        return
+    try:
+        same = load_scene(scene.source) == scene
+    except HfgpuError:  # a text that is not a whole scene (e.g. built in code from parts)
+        same = False
+    if not same:
+        warnings.warn("the scene was changed after it was read (Scene.replace): the results file stores the text "
+                      "it was read from, which does not describe this run; change keys with hfgpu.edit_scene",
+                      UserWarning, stacklevel=3)
+
+
 def check_supported(scene: Scene) -> None:
     """Raise :class:`NotSupportedError` for a physics set this version cannot run."""
     if tuple(scene.run.physics) not in SIMULATORS:
@@ -88,6 +106,7 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     so and its stored summary is returned. The Rerun recording of a resumed run holds the resumed part only.
     """
     scene = validate(scene_or_path)  # as ``hfgpu check``: limits and the engine's start (hfgpu.scene_checks)
+    warn_edited(scene)
     blas_thread_limit(0)  # a bad HFGPU_BLAS_THREADS is an error before any work
     simulate = simulator_for(scene)
     view, connect = _reachable_viewers(view, connect, viewer_required)

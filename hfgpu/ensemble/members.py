@@ -8,19 +8,12 @@ member's results file stores under ``/scene``.
 
 from __future__ import annotations
 
-import datetime
-import json
-import math
-import re
 from dataclasses import dataclass
-from typing import Any
 
 from ..errors import HfgpuError
+from ..scene_text import toml_text, with_value
 from .design import member_inputs
-from .sweep_file import Sweep, with_value
-
-_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+$")
-
+from .sweep_file import Sweep
 
 class MemberError(HfgpuError, ValueError):
     """A member scene of a sweep is not valid: the member, its inputs and the scene's own message."""
@@ -64,49 +57,3 @@ def members(sweep: Sweep) -> list[Member]:
             raise MemberError(f"sweep member {mid} ({said}): {exc}") from None
         out.append(Member(id=mid, inputs=inputs, scene_text=text))
     return out
-
-
-def toml_text(data: dict[str, Any]) -> str:
-    """TOML text of a parsed TOML document (``tomllib.loads(toml_text(d)) == d``)."""
-    lines: list[str] = []
-    _table(lines, (), data, header=False)
-    return "\n".join(lines).lstrip("\n") + "\n"
-
-
-def _table(lines: list[str], prefix: tuple[str, ...], table: dict[str, Any], header: bool,
-           array: bool = False) -> None:
-    if header:
-        name = ".".join(_key(k) for k in prefix)
-        lines.extend(["", f"[[{name}]]" if array else f"[{name}]"])
-    nested = []
-    for key, value in table.items():
-        if isinstance(value, dict) or (isinstance(value, list) and value and all(isinstance(v, dict) for v in value)):
-            nested.append((key, value))
-        else:
-            lines.append(f"{_key(key)} = {_value(value)}")
-    for key, value in nested:
-        if isinstance(value, dict):
-            _table(lines, prefix + (key,), value, header=True)
-        else:
-            for item in value:
-                _table(lines, prefix + (key,), item, header=True, array=True)
-
-
-def _key(key: str) -> str:
-    return key if _BARE_KEY.match(key) else json.dumps(key, ensure_ascii=False)
-
-
-def _value(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        return ("-inf" if value < 0 else "inf") if math.isinf(value) else "nan" if value != value else repr(value)
-    if isinstance(value, str):
-        return json.dumps(value, ensure_ascii=False)
-    if isinstance(value, (datetime.date, datetime.time)):
-        return value.isoformat()
-    if isinstance(value, list):
-        return "[" + ", ".join(_value(v) for v in value) + "]"
-    return "{ " + ", ".join(f"{_key(k)} = {_value(v)}" for k, v in value.items()) + " }"

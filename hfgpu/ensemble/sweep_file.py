@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import copy
 import math
-import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -29,6 +28,7 @@ from typing import Any
 from ..errors import MISSING, SceneError
 from ..scene import parse_scene
 from ..scene_reader import Table
+from ..scene_text import split_key, with_value
 from ..units import SI_UNITS, registry
 
 try:
@@ -44,7 +44,6 @@ DISTRIBUTIONS = {"uniform": ("low", "high"), "log-uniform": ("low", "high"), "no
 METRIC_NAMES = ("propped_area", "created_area", "propped_fraction", "fracture_height", "fracture_length",
                 "net_pressure_end", "efficiency", "screened_out")
 
-_STEP = re.compile(r"([A-Za-z_][A-Za-z0-9_-]*)(?:\[(\d+)\])?$")
 
 
 class SweepError(SceneError):
@@ -156,7 +155,7 @@ def _parse(top: Table, path: Path, source: str) -> Sweep:
 
 def _parse_vary(t: Table, scene_data: dict) -> Vary:
     key = t.string("key")
-    steps = split_key(key, t.key_path("key"), scene_data)
+    steps = split_key(key, t.key_path("key"), scene_data, SweepError, "base scene")
     if t.has("values"):
         if t.has("distribution"):
             raise SweepError(t.key_path("distribution"), t.raw("distribution"), "give either values or a "
@@ -193,48 +192,6 @@ def _check_params(t: Table, distribution: str, p: dict[str, float]) -> None:
     if distribution == "triangular" and not p["low"] <= p["mode"] <= p["high"]:
         raise SweepError(t.key_path("mode"), t.data["mode"], f"allowed: between low and high "
                          f"({p['low']:g} and {p['high']:g} in SI)")
-
-
-def split_key(key: str, where: str, scene_data: dict) -> tuple[tuple[str, int | None], ...]:
-    """``rock.layers[0].min_stress`` as ((rock, None), (layers, 0), (min_stress, None)), checked against the
-    base scene: every table on the way must exist there (the last name may be new: a scene default)."""
-    steps = []
-    node: Any = scene_data
-    parts = key.split(".")
-    for depth, part in enumerate(parts):
-        match = _STEP.match(part)
-        if match is None:
-            raise SweepError(where, key, "expected a scene key path such as 'rock.leakoff_coefficient' or "
-                             "'rock.layers[0].min_stress'")
-        name, index = match.group(1), match.group(2)
-        steps.append((name, None if index is None else int(index)))
-        last = depth == len(parts) - 1
-        if not isinstance(node, dict) or (name not in node and not (last and index is None)):
-            raise SweepError(where, key, f"the base scene has no '{'.'.join(parts[:depth + 1])}'")
-        node = node.get(name)
-        if index is not None:
-            if not isinstance(node, list) or int(index) >= len(node):
-                size = len(node) if isinstance(node, list) else 0
-                raise SweepError(where, key, f"index {index} is past the end of '{name}' in the base scene "
-                                 f"({size} {'entry' if size == 1 else 'entries'}, the first is [0])")
-            node = node[int(index)]
-    if isinstance(node, (dict, list)):
-        raise SweepError(where, key, "expected a key holding one value, not a table")
-    return tuple(steps)
-
-
-def with_value(scene_data: dict, steps: tuple[tuple[str, int | None], ...], value: Any) -> dict:
-    """A copy of the parsed scene with the value at the key path ``steps`` replaced (or added)."""
-    data = copy.deepcopy(scene_data)
-    node = data
-    for name, index in steps[:-1]:
-        node = node[name] if index is None else node[name][index]
-    name, index = steps[-1]
-    if index is None:
-        node[name] = value
-    else:
-        node[name][index] = value
-    return data
 
 
 def si_number(raw: Any) -> float:

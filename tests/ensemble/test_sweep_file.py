@@ -13,8 +13,9 @@ from pathlib import Path
 import pytest
 
 from hfgpu.ensemble import MemberError, SweepError, load_sweep
-from hfgpu.ensemble.members import members, toml_text
+from hfgpu.ensemble.members import members
 from hfgpu.scene import load_scene
+from hfgpu.scene_text import toml_text
 
 ROOT = Path(__file__).resolve().parents[2]
 SCRIPT = Path(sys.executable).with_name("hfgpu")

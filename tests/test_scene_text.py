@@ -1,0 +1,61 @@
+"""Scene keys changed as text (hfgpu/scene_text.py): the edited scene's values and its stored text agree."""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+from importlib.resources import files
+
+import pytest
+
+from hfgpu import edit_scene, load_scene
+from hfgpu.errors import SceneError
+from hfgpu.runner import warn_edited
+from hfgpu.scene_text import assignment
+
+FIELD = files("hfgpu") / "scenes" / "five_layer.toml"
+
+
+def test_edit_sets_nested_array_and_new_keys_and_keeps_the_text_true():
+    scene = load_scene(FIELD)
+    edited = edit_scene(scene, {"coupling.cell_size": "2.5 m", "proppant[0].size": "30/50",
+                                "rock.layers[2].min_stress": "62 MPa", "mppic.backend": "numpy"})
+    assert edited.coupling.cell_size == (2.5, 2.5)
+    assert edited.proppant.classes[0].sieve == "30/50"
+    assert edited.proppant == dataclasses.replace(scene.proppant.with_sieve("30/50"), numerics=dataclasses.replace(
+        scene.proppant.numerics, backend="numpy"))
+    assert edited.rock.layers[2].min_stress == pytest.approx(62e6)
+    assert edited.run == scene.run and edited.fluid == scene.fluid
+    assert load_scene(edited.source) == edited
+    assert edited.source.splitlines()[0].startswith('# edited: coupling.cell_size = "2.5 m"')
+
+
+@pytest.mark.parametrize("key, value, named", [
+    ("coupling.cell_sise", "2.5 m", "coupling.cell_sise"),        # unknown key: the scene's own error
+    ("couplings.cell_size", "2.5 m", "couplings.cell_size"),      # no such table
+    ("proppant[3].size", "30/50", "proppant[3].size"),             # past the end
+    ("coupling.cell_size", "-1 m", "coupling.cell_size"),          # out of range
+])
+def test_a_bad_key_or_value_names_the_key(key, value, named):
+    with pytest.raises(SceneError) as info:
+        edit_scene(load_scene(FIELD), {key: value})
+    assert named in str(info.value)
+
+
+def test_run_warns_when_the_scene_no_longer_matches_its_text():
+    scene = load_scene(FIELD)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        warn_edited(scene)
+        warn_edited(edit_scene(scene, {"run.end_time": "60 s"}))
+    with pytest.warns(UserWarning, match="edit_scene"):
+        warn_edited(scene.replace(run=dataclasses.replace(scene.run, end_time=60.0)))
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("run.seed=2", ("run.seed", 2)), ("mppic.shields_deposition = false", ("mppic.shields_deposition", False)),
+    ('coupling.cell_size="2.5 m"', ("coupling.cell_size", "2.5 m")),
+    ("rock.layers[0].bottom=2967.5 m", ("rock.layers[0].bottom", "2967.5 m")),
+])
+def test_assignment_reads_toml_values_and_plain_text(text, expected):
+    assert assignment(text) == expected
