@@ -60,6 +60,8 @@ from .scene_reader import Table
 DEFAULT_FRACTURE_SNAPSHOTS = 60
 #: Default outer radius of the inlet annulus, in (larger) proppant cell sizes.
 DEFAULT_INLET_CELLS = 1.5
+#: Default ``[coupling] min_width`` [m]: narrower cells are closed for the proppant run (parse_coupling).
+DEFAULT_MIN_WIDTH = 10e-6
 
 
 @dataclass(frozen=True)
@@ -72,11 +74,18 @@ class CouplingConfig:
     inlet_radius: float | None = None
     proppant_start: float | None = None
     margin: int = 1
+    min_width: float = DEFAULT_MIN_WIDTH
 
 
 def parse_coupling(t: Table, end_time: float, refinement: float = 1.0) -> CouplingConfig:
     """Read ``[coupling]`` (every key optional) into a :class:`CouplingConfig`; the proppant cells in use are
-    ``cell_size`` / ``refinement`` (``[mesh] refinement``, as the fracture cells)."""
+    ``cell_size`` / ``refinement`` (``[mesh] refinement``, as the fracture cells).
+
+    ``min_width``: proppant cells narrower than this are closed for the proppant run. A cell that opens between
+    two fracture snapshots passes through every width from 0 (the width is linear in time), and the fluid must
+    supply the leak-off of its faces: u ~ 2 q_L dx / w, ~300 m/s at w = 20 nm (measured on 2.5 m cells of the
+    field case), so the fluid Courant limit (Eq. 42) stops the run. At the default 10 um, u ~ 0.05 m/s for
+    q_L = 1e-7 m/s on 2.5 m cells; the fluid such cells hold (w dx dz) is dropped as in any closing cell."""
     positive = dict(minimum=0.0, exclusive_minimum=True)
     every = t.quantity("fracture_every", "time", end_time / DEFAULT_FRACTURE_SNAPSHOTS, **positive)
     size = t.raw("cell_size", None)
@@ -91,9 +100,10 @@ def parse_coupling(t: Table, end_time: float, refinement: float = 1.0) -> Coupli
     outer = t.quantity("inlet_radius", "length", None, minimum=inner, exclusive_minimum=True)
     start = t.quantity("proppant_start", "time", None, minimum=0.0, maximum=end_time, exclusive_maximum=True)
     margin = t.integer("margin", 1, minimum=0)
+    min_width = t.quantity("min_width", "length", DEFAULT_MIN_WIDTH, minimum=0.0)
     t.finish()
     return CouplingConfig(fracture_every=every, cell_size=cell_size, inlet_inner_radius=inner,
-                          inlet_radius=outer, proppant_start=start, margin=margin)
+                          inlet_radius=outer, proppant_start=start, margin=margin, min_width=min_width)
 
 
 def proppant_start_time(scene: Scene) -> float:
@@ -302,9 +312,10 @@ def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None =
     start = late_start(scene, start, float(history.times[0]))
     inj = scene.injection
     frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=(inj.x, inj.depth))
-    width0, _, _ = history.fields_at(start, frame, shape)
+    width0, _, _ = history.fields_at(start, frame, shape, cfg.min_width)
     sub = proppant_scene(scene, frame, shape, width0, start)
-    sim = ProppantSimulation(sub, width_field=lambda t: history.fields_at(t + start, frame, shape)[:2])
+    field = history.width_field(frame, shape, cfg.min_width)
+    sim = ProppantSimulation(sub, width_field=lambda t: field(t + start))
     sim.solver.step = timings.wrap("fluid", sim.solver.step)
     sim.engine.substeps = timings.wrap("parcels", sim.engine.substeps)
     shift = _ProppantShift(sink, start, scene.proppant.params.bridging_factor, timings)

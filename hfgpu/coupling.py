@@ -15,7 +15,7 @@ leak-off fields on that grid (the moving walls w of Eq. 7-8 and the sink s_l of 
   (:func:`bridging_risk`, reported only: the coupling is one-way).
 
 Public API: ``FractureHistory(snapshots)``, ``FractureHistory.from_results(path)``, ``history.times``,
-``history.fields_at(t, frame, shape)``, ``history.width_field(frame, shape)``,
+``history.fields_at(t, frame, shape, min_width=0)``, ``history.width_field(frame, shape, min_width=0)``,
 ``history.opening_time_on(frame, shape)``, ``history.injection_point()``,
 ``proppant_frame(history, cell_size=None, margin=1, source=None)``, ``bridging_risk(width, diameter, factor)``.
 """
@@ -141,13 +141,16 @@ class FractureHistory:
                 del self._cache[next(iter(self._cache))]
         return self._cache[key]
 
-    def fields_at(self, t: float, frame: GridFrame, shape: Shape) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def fields_at(self, t: float, frame: GridFrame, shape: Shape,
+                  min_width: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(width [m], leakoff_rate [m/s], open_mask) on the grid (frame, shape) at time t [s].
 
         Linear in time between the snapshots bracketing t, f = (1 - a) f_k + a f_(k+1),
         a = (t - t_k) / (t_(k+1) - t_k); zero before the first snapshot, the last snapshot after it.
-        open_mask: width > 0. A negative width (a cell drained by leak-off to round-off below 0; the engine holds
-        contact) is set to 0 (closed); leak-off is kept >= 0 and 0 in closed cells.
+        open_mask: width > ``min_width`` (default 0); other cells get width 0 (closed): a negative width (a cell
+        drained by leak-off to round-off below 0; the engine holds contact), and, with ``min_width`` > 0, the
+        nanometre widths that a cell passes through while it opens between two snapshots. Leak-off is kept >= 0
+        and 0 in closed cells.
         """
         shape = (int(shape[0]), int(shape[1]))
         k = int(np.searchsorted(self.times, t, side="right")) - 1
@@ -160,13 +163,13 @@ class FractureHistory:
             a = (t - self.times[k]) / (self.times[k + 1] - self.times[k])
             (w0, q0), (w1, q1) = self._on(k, frame, shape), self._on(k + 1, frame, shape)
             width, leak = (1.0 - a) * w0 + a * w1, (1.0 - a) * q0 + a * q1
-        width = np.maximum(width, 0.0)  # negative widths (no contact constraint in the engine) are closed
-        is_open = width > 0.0
-        return width, np.where(is_open, np.maximum(leak, 0.0), 0.0), is_open
+        is_open = width > max(min_width, 0.0)
+        return np.where(is_open, width, 0.0), np.where(is_open, np.maximum(leak, 0.0), 0.0), is_open
 
-    def width_field(self, frame: GridFrame, shape: Shape) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
+    def width_field(self, frame: GridFrame, shape: Shape,
+                    min_width: float = 0.0) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
         """``t -> (width, leakoff_rate)`` on the grid: the ``width_field`` the proppant simulator takes."""
-        return lambda t: self.fields_at(t, frame, shape)[:2]
+        return lambda t: self.fields_at(t, frame, shape, min_width)[:2]
 
     def opening_time_on(self, frame: GridFrame, shape: Shape) -> np.ndarray:
         """Opening time [s] on the grid: earliest over the snapshots of the earliest overlapping open source

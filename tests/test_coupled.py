@@ -67,9 +67,10 @@ def test_fluid_supplied_is_the_width_histories_mismatch(tiny):
     first, last = r.proppant_snapshots[0], r.proppant_snapshots[-1]
     shape = np.shape(last.grid["width"])
     area = last.frame.dx * last.frame.dz
-    volume = [np.sum(history.fields_at(t, last.frame, shape)[0]) * area for t in (20.0, 40.0)]
+    thin = r.scene.coupling.min_width  # narrower cells are closed for the proppant run
+    volume = [np.sum(history.fields_at(t, last.frame, shape, thin)[0]) * area for t in (20.0, 40.0)]
     times = np.linspace(20.0, 40.0, 401)
-    leak = [np.sum(history.fields_at(t, last.frame, shape)[1]) * area for t in times]
+    leak = [np.sum(history.fields_at(t, last.frame, shape, thin)[1]) * area for t in times]
     leaked = float(np.sum(0.5 * (np.add(leak[1:], leak[:-1])) * np.diff(times)))
     injected = 0.9 * 2e-3 * 20.0
     assert summary["proppant_fluid_injected"] == pytest.approx(injected, rel=1e-9)
@@ -91,7 +92,7 @@ def test_parcels_stay_inside_open_cells_and_width_follows_the_fracture(tiny):
         assert p["x"].size > 0 or snap.time == 20.0
         assert np.all((0 <= i) & (i < w.shape[1]) & (0 <= k) & (k < w.shape[0]))
         assert np.all(w[k, i] > 0.0)
-        expected, _, _ = history.fields_at(snap.time, snap.frame, w.shape)
+        expected, _, _ = history.fields_at(snap.time, snap.frame, w.shape, r.scene.coupling.min_width)
         np.testing.assert_allclose(w, expected, rtol=1e-12, atol=1e-15)
 
 
@@ -164,9 +165,10 @@ def test_runner_imports_both_physics_only_for_a_coupled_scene(tmp_path):
 
 def test_coupling_defaults_and_keys():
     scene = load_scene(TINY.replace('fracture_every = "5 s"', 'cell_size = ["2 m", "1 m"]\n'
-                                    'inlet_radius = "3 m"\nproppant_start = "10 s"'))
+                                    'inlet_radius = "3 m"\nproppant_start = "10 s"\nmin_width = "2 um"'))
     assert scene.coupling == CouplingConfig(fracture_every=40.0 / 60, cell_size=(2.0, 1.0), inlet_radius=3.0,
-                                            proppant_start=10.0)
+                                            proppant_start=10.0, min_width=2e-6)
+    assert load_scene(TINY).coupling.min_width == 10e-6
     assert proppant_start_time(scene) == 10.0
     assert proppant_start_time(load_scene(TINY)) == 20.0
 
@@ -177,6 +179,7 @@ def test_coupling_defaults_and_keys():
      "coupling.inlet_radius"),
     (lambda s: s.replace('fracture_every = "5 s"', 'proppant_start = "50 s"'), "coupling.proppant_start"),
     (lambda s: s.replace('fracture_every = "5 s"', 'speed = 2'), "coupling.speed"),
+    (lambda s: s.replace('fracture_every = "5 s"', 'min_width = "-1 um"'), "coupling.min_width"),
 ])
 def test_bad_coupled_scenes_name_the_key(edit, key):
     with pytest.raises(SceneError) as info:

@@ -135,6 +135,22 @@ def test_linear_in_time_field_is_interpolated_exactly_zero_before_and_last_after
     np.testing.assert_array_equal(history.width_field(frame, shape)(100.0)[0], last[0])
 
 
+def test_cells_narrower_than_min_width_are_closed_with_no_leakoff():
+    """A cell opening between two snapshots passes through every width from 0 (linear in time): with
+    min_width those below it are closed (width 0, no leak-off), the others unchanged."""
+    rng = np.random.default_rng(5)
+    a = _field(rng, (9, 12))
+    w1 = np.where(a > 0.0, 2e-3, 0.0)
+    history = FractureHistory([_snapshot(0.0, SRC, np.zeros_like(a), leak=np.zeros_like(a)),
+                               _snapshot(1.0, SRC, w1, leak=w1 * 1e-4)])
+    width, leak, is_open = history.fields_at(1e-3, SRC, a.shape, min_width=1e-6)  # 2 um where opening
+    np.testing.assert_allclose(width, np.where(a > 0.0, 2e-6, 0.0), rtol=1e-12, atol=0.0)
+    width, leak, is_open = history.fields_at(4e-4, SRC, a.shape, min_width=1e-6)  # 0.8 um: all closed
+    assert not width.any() and not leak.any() and not is_open.any()
+    assert history.fields_at(4e-4, SRC, a.shape)[2].sum() == np.count_nonzero(a > 0.0)  # default: open
+    np.testing.assert_array_equal(history.width_field(SRC, a.shape, 1e-6)(4e-4)[0], width)
+
+
 def test_growing_and_coarsened_footprint_opens_cells_and_keeps_volume():
     """t = 1: 5 x 5 fine cells open around the injection cell; t = 3: the engine's 3x coarser grid (blocks
     centred on the injection cell) with a 5 x 3 coarse footprint; the proppant grid is the fine one."""
