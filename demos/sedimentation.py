@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from hfgpu import load_scene  # noqa: E402
-from hfgpu.proppant.analysis import class_volume_fraction, interface_depth, row_profile  # noqa: E402
+from hfgpu.proppant.analysis import class_volume_fraction, fitted_speed, interface_depth, row_profile  # noqa: E402
 from hfgpu.proppant.simulator import ProppantSimulation  # noqa: E402
 from hfgpu.reference.settling import bidisperse_batch, bidisperse_interface_heights  # noqa: E402
 from hfgpu.records import MemorySink  # noqa: E402
@@ -85,8 +85,14 @@ def main() -> None:
     fig.suptitle(f"parcels at t = {snap.time:.0f} s")
     fig.tight_layout()
     fig.savefig(out / "davis_parcels_300s.png", dpi=150)
-    print(f"{summary['steps']} steps, {summary['parcels']} parcels; upper/lower theory "
-          f"{theory.upper_speed:.4e}/{theory.lower_speed:.4e} m/s; figures in {out}/")
+    speeds = []
+    for h in (upper, lower):  # fitted where the interface is 0.02-0.4 m below the top (tests/proppant/test_davis.py)
+        use = (height - h > 0.02) & (height - h < 0.4)
+        speeds.append(fitted_speed(t[use], height - h[use]) if use.sum() > 1 else float("nan"))
+    print(f"{summary['steps']} steps, {summary['parcels']} parcels; upper/lower interface speed "
+          f"{speeds[0]:.4e}/{speeds[1]:.4e} m/s, theory {theory.upper_speed:.4e}/{theory.lower_speed:.4e} m/s "
+          f"({100 * (speeds[0] / theory.upper_speed - 1):+.2f} % / {100 * (speeds[1] / theory.lower_speed - 1):+.2f} %); "
+          f"figures in {out}/")
 
 
 if __name__ == "__main__":

@@ -16,8 +16,16 @@ cells (width > 0) of the same grid.
 settling speed of 40/70 to 100 mesh sand in a 2 mPa s fluid, so only parcels held in a bed or a bridge count)
 or state 1 (bridged). The packed fraction is the share of parcels, as in the paper's probability plots.
 
+*Parcel groups* (:func:`parcel_groups`, where the parcels are): ``bridged`` (state 1); ``bed at rest`` and
+``moving bed``: resting in or on a dense bed or on the floor by the rule of bed friction
+(hfgpu.proppant.particle_ops_numpy.on_bed: its own cell or the one below at theta_p >= friction_volume_fraction,
+or within one diameter of a floor), slower / not slower than ``speed_threshold``; ``suspended``: the rest. Each
+group gives its share of the parcels, its median and 90th-percentile speed and, for the bed groups, the share
+below the threshold of motion: Shields number tau_b / ((rho_p - rho_f) g d) < theta_cr with tau_b = f_t
+sqrt(12) mu |u_f| / w of the fluid's x velocity at the parcel (hfgpu.proppant.closures; docs/proppant-closures.md).
+
 Public API: ``areal_solid(snap)``, ``propped_cells(snap, theta_cp, layers=1.0)``, ``created_area(snap)``,
-``packed_fraction(parcels, speed_threshold)``, ``area_history(results, ...)``, ``fracture_area_history(results)``,
+``packed_fraction(parcels, speed_threshold)``, ``parcel_groups(snap, setup, ...)``, ``area_history(results, ...)``, ``fracture_area_history(results)``,
 ``packed_history(results, times, ...)``, ``propped_summary(results, ...)``, ``equivalent_times(start, end)``.
 """
 
@@ -32,6 +40,8 @@ from .records import ProppantSnapshot
 
 #: Parcels slower than this [m/s] count as packed.
 PACKED_SPEED = 1e-3
+#: The groups of :func:`parcel_groups`, in print order.
+GROUPS = ("suspended", "moving bed", "bed at rest", "bridged")
 #: Times [s] of the paper's probability plots (Fig. 16).
 PAPER_TIMES = (1260.0, 1800.0, 3600.0)
 
@@ -97,6 +107,50 @@ def packed_fraction(parcels: dict[str, np.ndarray], speed_threshold: float = PAC
     if speed.size == 0:
         return float("nan")
     return float(np.mean((speed < speed_threshold) | (np.asarray(parcels["state"]) == 1)))
+
+
+def parcel_groups(snap: ProppantSnapshot, setup: Any, fluid_density: float, viscosity: float,
+                  speed_threshold: float = PACKED_SPEED) -> dict[str, dict[str, dict[str, float]]]:
+    """Where the parcels of a snapshot are (module docstring): {class name: {group: {"share", "count",
+    "median_speed", "p90_speed", "subcritical"}}} over :data:`GROUPS`, plus the class's ``"all"`` count.
+    ``setup`` is the scene's ProppantSetup (classes, params, gravity); ``viscosity`` the clean fluid's [Pa s].
+    Shares are of the class's parcels; speeds [m/s] are NaN and ``subcritical`` NaN for an empty group."""
+    from .proppant import closures
+    from .proppant.particle_ops_numpy import on_bed
+
+    params, gravity = setup.params, setup.numerics.gravity
+    p = {k: np.asarray(v) for k, v in snap.parcels.items()}
+    width, theta = np.asarray(snap.grid["width"]), np.asarray(snap.grid["volume_fraction"])
+    f = snap.frame
+    speed = np.hypot(p["u"], p["v"])
+    bridged = p["state"] == 1
+    bed = on_bed(p["x"], p["z"], p["radius"], f, width, theta, params) & ~bridged
+    member = {"suspended": ~bridged & ~bed, "moving bed": bed & (speed >= speed_threshold),
+              "bed at rest": bed & (speed < speed_threshold), "bridged": bridged}
+    fluid_u = np.asarray(snap.grid["fluid_u"])  # x faces (nz, nx + 1)
+    xi = np.clip((p["x"] - f.x0) / f.dx + 0.5, 0.0, width.shape[1])
+    i = np.clip(np.floor(xi).astype(int), 0, width.shape[1] - 1)
+    k = np.clip(np.floor((p["z"] - f.z0) / f.dz + 0.5).astype(int), 0, width.shape[0] - 1)
+    u_f = fluid_u[k, i] + (xi - i) * (fluid_u[k, i + 1] - fluid_u[k, i])
+    diameter = 2.0 * p["radius"]
+    tau = closures.bed_shear_stress(u_f, np.maximum(width[k, i], 1e-300), fluid_density, viscosity,
+                                    params.wall_friction)
+    below = closures.shields_number(tau, diameter, p["density"], fluid_density, gravity) \
+        < closures.critical_shields_number(diameter, p["density"], fluid_density, viscosity, gravity)
+    out = {}
+    for cid, cls in enumerate(setup.classes):
+        mine = p["class_id"] == cid
+        n = int(mine.sum())
+        groups: dict[str, dict[str, float]] = {"all": {"count": n}}
+        for name in GROUPS:
+            m = mine & member[name]
+            count = int(m.sum())
+            groups[name] = dict(share=count / n if n else float("nan"), count=count,
+                                median_speed=float(np.median(speed[m])) if count else float("nan"),
+                                p90_speed=float(np.percentile(speed[m], 90.0)) if count else float("nan"),
+                                subcritical=float(np.mean(below[m])) if count and "bed" in name else float("nan"))
+        out[cls.name] = groups
+    return out
 
 
 def _theta_cp(results, theta_cp: float | None) -> float:

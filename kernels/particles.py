@@ -199,7 +199,7 @@ def limited(delta, slip, grad, restitution: ti.f64):
 def on_bed(sx: ti.f64, sz: ti.f64, radius: ti.f64, dz: ti.f64, C: ti.template(), dense: ti.f64) -> ti.f64:
     """1.0 where the cell containing (sx, sz) or the cell below it (+z) has theta_p >= dense, or the cell below
     is closed or outside the grid and the parcel is within 2 radius of that wall, else 0.0
-    (particle_ops_numpy._on_bed; 0 outside the grid)."""
+    (particle_ops_numpy.on_bed; 0 outside the grid)."""
     out = 0.0
     k, i = owner(sx, sz)
     if k >= 0 and k < C.shape[1] and i >= 0 and i < C.shape[2]:

@@ -6,8 +6,12 @@ import numpy as np
 import pytest
 
 from hfgpu.io.results import ResultsWriter
+from types import SimpleNamespace
+
+from hfgpu.proppant import closures
+from hfgpu.proppant.params import MppicParams
 from hfgpu.propped import (area_history, areal_solid, created_area, fracture_area_history, packed_fraction,
-                           packed_history, propped_cells, propped_summary)
+                           packed_history, parcel_groups, propped_cells, propped_summary)
 from hfgpu.records import FractureSnapshot, GridFrame, ProppantSnapshot
 
 FRAME = GridFrame(dx=2.0, dz=1.0, x0=10.0, z0=100.0)
@@ -53,6 +57,33 @@ def test_areal_solid_and_propped_cells_match_the_construction():
     assert created_area(snap) == pytest.approx(9 * FRAME.dx * FRAME.dz)
     with pytest.raises(ValueError, match="theta_cp"):
         propped_cells(snap, 1.2)
+
+
+def test_parcel_groups_sort_parcels_by_the_bed_rule_and_the_threshold_of_motion():
+    """Six parcels placed by hand: a floor parcel at rest, one resting on a dense cell and moving under a
+    sub-critical fluid, one on a floor under a super-critical fluid, two suspended, one bridged."""
+    parcels = _parcels([(2, 0), (1, 1), (2, 2), (0, 0), (0, 2), (1, 0)], [0.1] * 6,
+                       [0.0, 0.05, 0.2, 0.1, 2e-4, 0.0], state=[0, 0, 0, 0, 0, 1])
+    parcels["z"] = parcels["z"].copy()
+    parcels["z"][[0, 2]] = FRAME.z0 + 2.5 * FRAME.dz - 1e-4  # within one diameter of the grid's floor
+    snap = _snapshot(1.0, parcels)
+    snap.grid["volume_fraction"][2, 1] = 0.55  # the dense cell under parcel 1
+    snap.grid["fluid_u"][1, :] = 0.1  # row 1: 0.1 m/s, row 2: 1 m/s
+    snap.grid["fluid_u"][2, :] = 1.0
+    setup = SimpleNamespace(params=MppicParams(), numerics=SimpleNamespace(gravity=9.81),
+                            classes=(SimpleNamespace(name="sand"),))
+    # the critical speed of these grains in water over a 5 mm gap lies between the two rows' speeds
+    u_cr = closures.critical_shields_number(D, 2650.0, 1000.0, 1e-3, 9.81) * 1650.0 * 9.81 * D * 5e-3 \
+        / (np.sqrt(12.0) * 1e-3)
+    assert 0.1 < u_cr < 1.0
+    g = parcel_groups(snap, setup, 1000.0, 1e-3)["sand"]
+    assert g["all"]["count"] == 6
+    assert {name: g[name]["count"] for name in ("suspended", "moving bed", "bed at rest", "bridged")} \
+        == {"suspended": 2, "moving bed": 2, "bed at rest": 1, "bridged": 1}
+    assert g["moving bed"]["subcritical"] == pytest.approx(0.5)  # parcel 1 below, parcel 2 above
+    assert g["bed at rest"]["subcritical"] == 0.0  # on the floor of row 2 (1 m/s)
+    assert g["moving bed"]["median_speed"] == pytest.approx(0.125)
+    assert g["suspended"]["share"] == pytest.approx(2 / 6) and np.isnan(g["suspended"]["subcritical"])
 
 
 def test_packed_fraction_counts_slow_and_bridged_parcels():

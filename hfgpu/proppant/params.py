@@ -60,11 +60,12 @@ class MppicParams:
     friction of smooth plane-channel flow, c_f = 0.073 Re^(-1/4), past the crossing of the two laws at
     Re = 899 (identical to "laminar" below it; hfgpu.proppant.momentum).
     shields_deposition: threshold of motion on the bed surface (push, particle_ops_numpy._deposited): a
-    parcel resting on a bed surface (on a floor, or above a dense cell, its own cell loose; _on_bed) stops along
+    parcel resting on a bed surface (on a floor, or above a dense cell, its own cell loose; on_bed) stops along
     the bed (x velocity 0) while the Shields number of the bed shear stress of the fluid it sees is below the
     critical one: tau_b / ((rho_p - rho_f) g d) < theta_cr (Shields 1936; theta_cr of Soulsby & Whitehouse
     1997; tau_b = f_t sqrt(12) mu_o |u_f| / w, the surface stress of the gap-averaged flow, closures); above
-    it the grain is entrained and only bed friction slows it. Default false (docs/proppant-closures.md).
+    it the grain is entrained and only bed friction slows it. Default true: the threshold of motion is what
+    makes a bed a bed (reasons and measurements in docs/proppant-closures.md).
     """
 
     theta_cp: float = 0.6
@@ -85,7 +86,7 @@ class MppicParams:
     bed_friction: float = 0.543
     friction_volume_fraction: float = 0.5
     wall_friction: str = "laminar"
-    shields_deposition: bool = False
+    shields_deposition: bool = True
 
     def __post_init__(self) -> None:
         def bad(name: str, allowed: str) -> SceneError:

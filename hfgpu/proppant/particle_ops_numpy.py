@@ -181,18 +181,19 @@ def _limited_stress_velocity(delta, slip, grad, restitution):
                     np.minimum(np.maximum(delta, bound), 0.0))
 
 
-def _on_bed(x, z, radius, frame: GridFrame, fields: GridFields, params: MppicParams) -> np.ndarray:
+def on_bed(x, z, radius, frame: GridFrame, width: np.ndarray, volume_fraction: np.ndarray,
+           params: MppicParams) -> np.ndarray:
     """True where the parcel rests in or on a dense bed: its own cell or the cell below it (+z, the direction
     of gravity) has theta_p (Eq. 38, this step's scatter) >= friction_volume_fraction; or it lies on the floor:
     the cell below is closed or outside the grid and the parcel is within one diameter 2 r of that wall (the
     sub-cell layer of grains on a floor that a cell-averaged theta_p does not resolve)."""
-    nz, _ = fields.width.shape
-    k, i, inside = owning_cell(x, z, frame, fields.width.shape)
+    nz, _ = width.shape
+    k, i, inside = owning_cell(x, z, frame, width.shape)
     below = np.minimum(k + 1, nz - 1)
     has_below = k + 1 < nz
-    dense = (fields.volume_fraction[k, i] >= params.friction_volume_fraction) \
-        | (has_below & (fields.volume_fraction[below, i] >= params.friction_volume_fraction))
-    floor = ~has_below | (fields.width[below, i] <= 0.0)
+    dense = (volume_fraction[k, i] >= params.friction_volume_fraction) \
+        | (has_below & (volume_fraction[below, i] >= params.friction_volume_fraction))
+    floor = ~has_below | (width[below, i] <= 0.0)
     on_floor = floor & ((k + 0.5 - (z - frame.z0) / frame.dz) * frame.dz <= 2.0 * radius)
     return inside & (dense | on_floor)
 
@@ -208,7 +209,7 @@ def _bed_friction(u, on_bed, buoyant_g, dt, den, params: MppicParams):
 def _deposited(x, z, on_bed, seen: ParcelFluid, radius, rho_p, frame: GridFrame, fields: GridFields,
                params: MppicParams, fluid_density, fluid_viscosity, gravity) -> np.ndarray:
     """True where a parcel rests on a bed surface below the threshold of motion (shields_deposition): on a
-    bed (_on_bed) with its own cell loose (theta_p < friction_volume_fraction: a grain on the floor or on top
+    bed (on_bed) with its own cell loose (theta_p < friction_volume_fraction: a grain on the floor or on top
     of a dense cell, not inside the bed) and a Shields number of the bed shear stress of the fluid velocity
     along the bed it sees below the critical one, tau_b / ((rho_p - rho_f) g 2r) < theta_cr
     (closures.bed_shear_stress, closures.critical_shields_number)."""
@@ -218,7 +219,8 @@ def _deposited(x, z, on_bed, seen: ParcelFluid, radius, rho_p, frame: GridFrame,
     surface = on_bed & (fields.volume_fraction[k, i] < params.friction_volume_fraction)
     width = np.where(surface, seen.width, 1.0)
     tau = closures.bed_shear_stress(seen.fluid_u, width, fluid_density, fluid_viscosity, params.wall_friction)
-    shields = closures.shields_number(tau, 2.0 * radius, rho_p, fluid_density, gravity)
+    with np.errstate(divide="ignore", invalid="ignore"):  # a neutrally buoyant grain: no threshold, never held
+        shields = closures.shields_number(tau, 2.0 * radius, rho_p, fluid_density, gravity)
     return surface & (shields < closures.critical_shields_number(2.0 * radius, rho_p, fluid_density,
                                                                  fluid_viscosity, gravity))
 
@@ -276,7 +278,7 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     bounds the velocity relative to the cell's mean parcel velocity, which does not stop a stream of parcels
     that arrives together against a wall; the cap bounds every cell's theta_p by theta_cp plus one step's
     inflow, whatever the parcels' velocities.
-    Bed friction: where the parcel rests in or on a dense bed or on the floor (_on_bed) its x velocity is
+    Bed friction: where the parcel rests in or on a dense bed or on the floor (on_bed) its x velocity is
     reduced by Coulomb friction (_bed_friction, mu_b = bed_friction) before the walls; with
     shields_deposition, one on a bed surface below the threshold of motion (_deposited) stops along x.
     Bridging: where the width of the parcel's cell is below bridging_factor x 2 r the parcel is set to state 1
@@ -299,9 +301,9 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
                                              params.packing_restitution)
     v_new = v_new + _limited_stress_velocity(scale * seen.dtaudz, seen.mean_v - v_new, seen.dtaudz,
                                              params.packing_restitution)
-    on_bed = _on_bed(parcels.x, parcels.z, parcels.radius, frame, fields, params)
-    u_new = _bed_friction(u_new, on_bed, buoyant_g, dt, den, params)
-    u_new = np.where(_deposited(parcels.x, parcels.z, on_bed, seen, parcels.radius, rho_p, frame, fields, params,
+    resting = on_bed(parcels.x, parcels.z, parcels.radius, frame, fields.width, fields.volume_fraction, params)
+    u_new = _bed_friction(u_new, resting, buoyant_g, dt, den, params)
+    u_new = np.where(_deposited(parcels.x, parcels.z, resting, seen, parcels.radius, rho_p, frame, fields, params,
                                 fluid_density, fluid_viscosity, gravity), 0.0, u_new)
     bridged = seen.width < params.bridging_factor * 2.0 * parcels.radius
     u_new = np.where(bridged, 0.0, u_new)

@@ -77,7 +77,7 @@ def test_bed_friction_holds_resting_grains_and_slows_sliding_ones(backend_name):
             v, p = np.zeros((3, 3)), np.zeros((2, 3))
             result = {}
             for mu_b in (0.0, 0.543):
-                params = MppicParams(damping=False, drag_iterations=1, bed_friction=mu_b)
+                params = MppicParams(damping=False, drag_iterations=1, bed_friction=mu_b, shields_deposition=False)
                 parcels = Parcels.create(x, z, radius=r, density=rho_p, particles=particles)
                 engine = engine_for(backend_name, frame, width, params)
                 engine.set_parcels(parcels)
