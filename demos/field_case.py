@@ -10,30 +10,48 @@ base case ``five_layer.toml``. Writes ``<out>/field.h5``, ``<out>/figures/*.png`
 from __future__ import annotations
 
 import argparse
-import dataclasses
 from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
 
-from hfgpu import load_scene, run  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+
+from hfgpu import edit_scene, load_scene, run  # noqa: E402
 from hfgpu.io.plots import plot_results  # noqa: E402
-from hfgpu.propped import packed_history, propped_summary  # noqa: E402
+from hfgpu.propped import area_history, packed_history, propped_summary  # noqa: E402
 
 SCENES = Path(__file__).resolve().parents[1] / "hfgpu" / "scenes"
 
 
-def load(scaled: bool, backend: str | None = None, size: str | None = None):
-    """The base (or scaled) five-layer scene; ``backend`` overrides [mppic] backend, ``size`` the sieve class
-    (the proppant class keeps its name, so the schedule still refers to it)."""
+def load(scaled: bool, backend: str | None = None, size: str | None = None, changes: dict | None = None):
+    """The base (or scaled) five-layer scene; ``backend`` sets [mppic] backend, ``size`` the sieve class of every
+    proppant class (names kept, so the schedule still refers to them), ``changes`` any other keys
+    ({"run.seed": 2}). Changed as text (hfgpu.edit_scene), so the results file stores the scene that ran."""
     scene = load_scene(SCENES / ("five_layer_demo.toml" if scaled else "five_layer.toml"))
-    setup = scene.proppant
-    if backend is not None:
-        setup = dataclasses.replace(setup, numerics=dataclasses.replace(setup.numerics, backend=backend))
+    changes = dict(changes or {}) | ({} if backend is None else {"mppic.backend": backend})
     if size is not None:
-        setup = setup.with_sieve(size)
-    return scene.replace(proppant=setup)
+        changes.update({f"proppant[{i}].size": size for i in range(len(scene.proppant.classes))})
+    return edit_scene(scene, changes) if changes else scene
+
+
+def propped_area_panel(ax, paths: dict[str, Path]) -> None:
+    """Propped area against time of each results file (labelled by its key), and the created area of the last."""
+    for label, path in paths.items():
+        history = area_history(path)
+        ax.plot(history["time"], history["propped"], label=label)
+    ax.plot(history["time"], history["created"], color="k", linestyle=":", label="created")
+    ax.set(xlabel="time [s]", ylabel="area [m^2] (one face)", title="propped area")
+    ax.legend(fontsize=8)
+
+
+def save(fig, target: Path) -> Path:
+    """Write a study's figure (110 dpi) and close it."""
+    fig.tight_layout()
+    fig.savefig(target, dpi=110)
+    plt.close(fig)
+    return target
 
 
 def report(path: Path) -> dict:
