@@ -66,7 +66,7 @@ def split_key(key: str, where: str, scene_data: dict, error: type[SceneError] = 
         match = _STEP.match(part)
         if match is None:
             raise error(where, key, "expected a scene key path such as 'rock.leakoff_coefficient' or "
-                             "'rock.layers[0].min_stress'")
+                        "'rock.layers[0].min_stress'")
         name, index = match.group(1), match.group(2)
         steps.append((name, None if index is None else int(index)))
         last = depth == len(parts) - 1
@@ -77,7 +77,7 @@ def split_key(key: str, where: str, scene_data: dict, error: type[SceneError] = 
             if not isinstance(node, list) or int(index) >= len(node):
                 size = len(node) if isinstance(node, list) else 0
                 raise error(where, key, f"index {index} is past the end of '{name}' in the {scene_name} "
-                                 f"({size} {'entry' if size == 1 else 'entries'}, the first is [0])")
+                            f"({size} {'entry' if size == 1 else 'entries'}, the first is [0])")
             node = node[int(index)]
     if isinstance(node, (dict, list)):
         raise error(where, key, "expected a key holding one value, not a table")

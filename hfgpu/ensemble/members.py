@@ -15,6 +15,7 @@ from ..scene_text import toml_text, with_value
 from .design import member_inputs
 from .sweep_file import Sweep
 
+
 class MemberError(HfgpuError, ValueError):
     """A member scene of a sweep is not valid: the member, its inputs and the scene's own message."""
 

@@ -45,7 +45,6 @@ METRIC_NAMES = ("propped_area", "created_area", "propped_fraction", "fracture_he
                 "net_pressure_end", "efficiency", "screened_out")
 
 
-
 class SweepError(SceneError):
     """A sweep file value is missing, malformed or out of range: like a :class:`SceneError`, but the message
     says ``sweep key 'vary[0].low': got ...; allowed ...``."""
