@@ -142,13 +142,16 @@ def estimated_parcels(scene) -> float | None:
 
 
 def grid_cells(scene) -> float:
-    """Cells of a box or slot scene's proppant grid, round(length / dx) x round(height / dz) (build_grid) without
-    building it; 0 for other geometries (a coupled grid is known only once the fracture has run; a width file's
-    grid is already read)."""
+    """Cells of a box or slot scene's proppant grid (hfgpu.proppant.simulator.box_shape) without building it; 0
+    for other geometries (a coupled grid is known only once the fracture has run; a width file's grid is already
+    read)."""
+    from .proppant.simulator import box_shape
+
     geometry = scene.proppant.geometry
     if geometry.kind not in ("box", "slot"):
         return 0.0
-    return max(1.0, round(geometry.length / scene.mesh.dx)) * max(1.0, round(geometry.height / scene.mesh.dz))
+    nz, nx = box_shape(geometry, scene.mesh)
+    return float(nz) * float(nx)
 
 
 def _check_grid_memory(scene, memory: int) -> int:

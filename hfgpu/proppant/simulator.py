@@ -76,9 +76,13 @@ def build_grid(geometry: Geometry, mesh) -> StaggeredGrid:
         x, z = geometry.field_x, geometry.field_z
         frame = GridFrame(dx=float(x[1] - x[0]), dz=float(z[1] - z[0]), x0=float(x[0]), z0=float(z[0]))
         return StaggeredGrid.from_width(frame, geometry.field_w)
-    nx = max(1, round(geometry.length / mesh.dx))
-    nz = max(1, round(geometry.height / mesh.dz))
+    nz, nx = box_shape(geometry, mesh)
     return StaggeredGrid.box(geometry.length, geometry.height, geometry.width, nx, nz)
+
+
+def box_shape(geometry: Geometry, mesh) -> tuple[int, int]:
+    """(nz, nx) of a box or slot grid: round(height / dz) x round(length / dx) cells, at least one each."""
+    return max(1, round(geometry.height / mesh.dz)), max(1, round(geometry.length / mesh.dx))
 
 
 def particles_per_parcel(setup: ProppantSetup, schedule, cell_volume: float) -> list[float]:
