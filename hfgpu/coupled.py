@@ -312,9 +312,8 @@ def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None =
     start = late_start(scene, start, float(history.times[0]))
     inj = scene.injection
     frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=(inj.x, inj.depth))
-    width0, _, _ = history.fields_at(start, frame, shape, cfg.min_width)
-    sub = proppant_scene(scene, frame, shape, width0, start)
     field = history.width_field(frame, shape, cfg.min_width)
+    sub = proppant_scene(scene, frame, shape, field(start)[0], start)
     sim = ProppantSimulation(sub, width_field=lambda t: field(t + start))
     sim.solver.step = timings.wrap("fluid", sim.solver.step)
     sim.engine.substeps = timings.wrap("parcels", sim.engine.substeps)

@@ -106,7 +106,8 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     so and its stored summary is returned. The Rerun recording of a resumed run holds the resumed part only.
     """
     scene = validate(scene_or_path)  # as ``hfgpu check``: limits and the engine's start (hfgpu.scene_checks)
-    warn_edited(scene)
+    if isinstance(scene_or_path, Scene):  # one read from a file is its text
+        warn_edited(scene)
     blas_thread_limit(0)  # a bad HFGPU_BLAS_THREADS is an error before any work
     simulate = simulator_for(scene)
     view, connect = _reachable_viewers(view, connect, viewer_required)
