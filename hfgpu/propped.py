@@ -25,7 +25,8 @@ below the threshold of motion: Shields number tau_b / ((rho_p - rho_f) g d) < th
 sqrt(12) mu |u_f| / w of the fluid's x velocity at the parcel (hfgpu.proppant.closures; docs/proppant-closures.md).
 
 Public API: ``areal_solid(snap)``, ``propped_cells(snap, theta_cp, layers=1.0)``, ``created_area(snap)``,
-``packed_fraction(parcels, speed_threshold)``, ``parcel_groups(snap, setup, ...)``, ``area_history(results, ...)``, ``fracture_area_history(results)``,
+``packed_fraction(parcels, speed_threshold)``, ``shields_ratio(snap, setup, ...)``, ``parcel_groups(snap, setup,
+...)``, ``area_history(results, ...)``, ``fracture_area_history(results)``,
 ``packed_history(results, times, ...)``, ``propped_summary(results, ...)``, ``equivalent_times(start, end)``.
 """
 
@@ -109,34 +110,42 @@ def packed_fraction(parcels: dict[str, np.ndarray], speed_threshold: float = PAC
     return float(np.mean((speed < speed_threshold) | (np.asarray(parcels["state"]) == 1)))
 
 
+def shields_ratio(snap: ProppantSnapshot, setup: Any, fluid_density: float, viscosity: float) -> np.ndarray:
+    """Per parcel, its Shields number over the critical one (hfgpu.proppant.closures): tau_b = f_t sqrt(12) mu
+    |u_f| / w of the fluid's x velocity u_f at the parcel (linear between its cell's x faces) and its cell's
+    width w; below 1 the grain would rest on a bed surface. ``setup`` is the scene's ProppantSetup."""
+    from .proppant import closures
+    from .proppant.interpolation import owning_cell
+
+    p, f = snap.parcels, snap.frame
+    width = np.asarray(snap.grid["width"])
+    k, i, _ = owning_cell(p["x"], p["z"], f, width.shape)
+    fluid_u = np.asarray(snap.grid["fluid_u"])  # x faces (nz, nx + 1)
+    a = np.clip((p["x"] - f.x0) / f.dx + 0.5 - i, 0.0, 1.0)
+    u_f = fluid_u[k, i] + a * (fluid_u[k, i + 1] - fluid_u[k, i])
+    diameter, rho_p, g = 2.0 * np.asarray(p["radius"]), np.asarray(p["density"]), setup.numerics.gravity
+    tau = closures.bed_shear_stress(u_f, np.maximum(width[k, i], 1e-300), fluid_density, viscosity,
+                                    setup.params.wall_friction)
+    return closures.shields_number(tau, diameter, rho_p, fluid_density, g) \
+        / closures.critical_shields_number(diameter, rho_p, fluid_density, viscosity, g)
+
+
 def parcel_groups(snap: ProppantSnapshot, setup: Any, fluid_density: float, viscosity: float,
                   speed_threshold: float = PACKED_SPEED) -> dict[str, dict[str, dict[str, float]]]:
     """Where the parcels of a snapshot are (module docstring): {class name: {group: {"share", "count",
     "median_speed", "p90_speed", "subcritical"}}} over :data:`GROUPS`, plus the class's ``"all"`` count.
     ``setup`` is the scene's ProppantSetup (classes, params, gravity); ``viscosity`` the clean fluid's [Pa s].
     Shares are of the class's parcels; speeds [m/s] are NaN and ``subcritical`` NaN for an empty group."""
-    from .proppant import closures
     from .proppant.particle_ops_numpy import on_bed
 
-    params, gravity = setup.params, setup.numerics.gravity
     p = {k: np.asarray(v) for k, v in snap.parcels.items()}
     width, theta = np.asarray(snap.grid["width"]), np.asarray(snap.grid["volume_fraction"])
-    f = snap.frame
     speed = np.hypot(p["u"], p["v"])
     bridged = p["state"] == 1
-    bed = on_bed(p["x"], p["z"], p["radius"], f, width, theta, params) & ~bridged
+    bed = on_bed(p["x"], p["z"], p["radius"], snap.frame, width, theta, setup.params) & ~bridged
     member = {"suspended": ~bridged & ~bed, "moving bed": bed & (speed >= speed_threshold),
               "bed at rest": bed & (speed < speed_threshold), "bridged": bridged}
-    fluid_u = np.asarray(snap.grid["fluid_u"])  # x faces (nz, nx + 1)
-    xi = np.clip((p["x"] - f.x0) / f.dx + 0.5, 0.0, width.shape[1])
-    i = np.clip(np.floor(xi).astype(int), 0, width.shape[1] - 1)
-    k = np.clip(np.floor((p["z"] - f.z0) / f.dz + 0.5).astype(int), 0, width.shape[0] - 1)
-    u_f = fluid_u[k, i] + (xi - i) * (fluid_u[k, i + 1] - fluid_u[k, i])
-    diameter = 2.0 * p["radius"]
-    tau = closures.bed_shear_stress(u_f, np.maximum(width[k, i], 1e-300), fluid_density, viscosity,
-                                    params.wall_friction)
-    below = closures.shields_number(tau, diameter, p["density"], fluid_density, gravity) \
-        < closures.critical_shields_number(diameter, p["density"], fluid_density, viscosity, gravity)
+    below = shields_ratio(snap, setup, fluid_density, viscosity) < 1.0
     out = {}
     for cid, cls in enumerate(setup.classes):
         mine = p["class_id"] == cid

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 from hfgpu import open_results, run
-from hfgpu.proppant import closures
+from hfgpu.proppant.interpolation import owning_cell
 from hfgpu.proppant.particle_ops_numpy import on_bed
+from hfgpu.propped import shields_ratio
 
 ROOT = Path(__file__).resolve().parents[1]
 END = 1800.0
@@ -72,14 +73,9 @@ def test_bed_surface_grains_below_the_threshold_of_motion_do_not_slide(grids, ce
     params, f = scene.proppant.params, snap.frame
     p = {k: np.asarray(v) for k, v in snap.parcels.items()}
     width, theta = np.asarray(snap.grid["width"]), np.asarray(snap.grid["volume_fraction"])
-    k = np.clip(np.floor((p["z"] - f.z0) / f.dz + 0.5).astype(int), 0, width.shape[0] - 1)
-    i = np.clip(np.floor((p["x"] - f.x0) / f.dx + 0.5).astype(int), 0, width.shape[1] - 1)
+    k, i, _ = owning_cell(p["x"], p["z"], f, width.shape)
     surface = on_bed(p["x"], p["z"], p["radius"], f, width, theta, params) \
         & (theta[k, i] < params.friction_volume_fraction) & (p["state"] == 0)
-    u_f = 0.5 * (np.asarray(snap.grid["fluid_u"])[k, i] + np.asarray(snap.grid["fluid_u"])[k, i + 1])
-    rho_f, mu, g, d = scene.fluid.density, scene.fluid.viscosity, scene.proppant.numerics.gravity, 2 * p["radius"]
-    tau = closures.bed_shear_stress(u_f, np.maximum(width[k, i], 1e-300), rho_f, mu, params.wall_friction)
-    below = surface & (closures.shields_number(tau, d, p["density"], rho_f, g)
-                       < 0.5 * closures.critical_shields_number(d, p["density"], rho_f, mu, g))
+    below = surface & (shields_ratio(snap, scene.proppant, scene.fluid.density, scene.fluid.viscosity) < 0.5)
     assert below.sum() > 0
     assert np.mean(np.abs(p["u"][below]) < 1e-3) >= 0.9  # 1.00 on 5 m cells; 0.11 with the rule off
