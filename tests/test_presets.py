@@ -131,8 +131,8 @@ def test_refinement_divides_cell_sizes_and_scales_the_cap():
                                                                            'cell_size = ["0.1 m", "0.3 m"]'))
     assert (scene.mesh.dx, scene.mesh.dz) == (0.05, 0.15)
     assert scene.mesh.scene_cell_size == pytest.approx((0.1, 0.3), rel=1e-15)
-    assert scene.mesh.max_cells_across == 80                              # 40 in the scene x 2
-    fast = load_scene(scene_text("radial_long.toml", "fast").replace("max_cells_across = 40",
+    assert scene.mesh.max_cells_across == 48                              # 24 in the scene x 2
+    fast = load_scene(scene_text("radial_long.toml", "fast").replace("max_cells_across = 24",
                                                                       "max_cells_across = 10"))
     assert fast.mesh.dx == 0.2 and fast.mesh.max_cells_across == 8         # 5 raised to the smallest cap
     coupled = load_scene(scene_text(COUPLED, "accurate", coupling='cell_size = "4 m"'))

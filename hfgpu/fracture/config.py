@@ -14,7 +14,10 @@ class FractureNumerics:
 
     time_step_relaxation: lambda of Eq. 35, dt = lambda min(dx, dz) / max(V_T).
     newton_tolerance: epsilon of Eq. 32 (relative).
-    linear_solver: "auto" (direct below ``krylov_threshold`` cells, Newton-Krylov above), "direct", "krylov".
+    linear_solver: "auto" (per active set, dense LU or Newton-Krylov, whichever the cost model of
+        solver_choice.py says is cheaper per Newton iteration; with ``krylov_threshold`` set: direct below that
+        many cells, Newton-Krylov from it), "direct", "krylov".
+    krylov_threshold: the fixed cell count of "auto" (None: the cost model chooses).
     newton_max_iterations: Newton iterations per step before the step is retried with half the time step.
     max_step_retries: halvings of a failed step before the run stops with a SimulationError.
     initial_radius_cells: radius of the starting radial fracture, in cells (see front.initial_fracture).
@@ -43,7 +46,7 @@ class FractureNumerics:
     newton_tolerance: float = BALANCED.newton_tolerance
     newton_max_iterations: int = 30
     linear_solver: str = "auto"
-    krylov_threshold: int = 3000
+    krylov_threshold: int | None = None
     max_step_retries: int = 8
     initial_radius_cells: float = 2.5
     tip_asymptote: str = "km"
@@ -66,7 +69,7 @@ def parse_fracture_numerics(t: Table, preset: Preset = BALANCED) -> FractureNume
                                   exclusive_minimum=True, maximum=0.1),
         newton_max_iterations=t.integer("newton_max_iterations", d.newton_max_iterations, minimum=1),
         linear_solver=t.choice("linear_solver", ("auto", "direct", "krylov"), d.linear_solver),
-        krylov_threshold=t.integer("krylov_threshold", d.krylov_threshold, minimum=1),
+        krylov_threshold=t.integer("krylov_threshold", minimum=1) if t.has("krylov_threshold") else None,
         max_step_retries=t.integer("max_step_retries", d.max_step_retries, minimum=0),
         initial_radius_cells=t.number("initial_radius_cells", d.initial_radius_cells, minimum=1.0,
                                       maximum=50.0),

@@ -11,7 +11,7 @@ fraction ``fill`` and distance ``advance``, on the step's own grid and footprint
 t_a). Where a cell had no solved pressure at t_a (it was not part of the solve ending at t_a: opened at or
 after t_a, or the starting fracture, whose pressure is not solved) p(t) = p(t_b). The leak-off rate is the
 step's own (the volume it leaked over its length), and the opening, arrival and crossing times are those
-of t_b's state, so the cells-mode filled fraction (geometry.filled_fraction) is evaluated at t itself.
+of t_b's state; the cells front's filled fractions (geometry.filled_fraction) follow from the interpolated widths.
 
 Volume. The injection rate is constant within a step (schedule breakpoints are step targets), so the
 injected volume V_I is linear in time within it; the stored volume V_S = dx dz sum w and the leaked total V_L

@@ -70,6 +70,7 @@ from .leakoff import carter_demand, carter_volume
 from .lubrication import build_faces
 from .mesh import GROW, Grid
 from .newton import Elasticity, StepProblem, solve_step, start_widths
+from .solver_choice import use_dense
 from .tip_cells import fill_and_width, level_set, ribbon_distances
 
 K_PRIME_FACTOR = math.sqrt(32.0 / math.pi)   # K' = sqrt(32/pi) K_Ic
@@ -236,9 +237,7 @@ class _Engine:
     def _rebuild(self) -> None:
         """Systems of the current active set: indices, faces, C (dense or FFT), properties."""
         self.rows, self.cols, self.ix, self.iz = self.grid.active_indices()
-        n = self.ix.size
-        solver = self.num.linear_solver
-        dense = solver == "direct" or (solver == "auto" and n < self.num.krylov_threshold)
+        dense = use_dense(self.num.linear_solver, self.num.krylov_threshold, self.ix, self.iz)
         self.elastic = Elasticity(self.op, self.ix, self.iz, dense)
         self.faces = build_faces(self.ix, self.iz, self.dx, self.dz, self.mu_prime)
         sel = (self.rows, self.cols)
@@ -292,9 +291,12 @@ class _Engine:
         w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
         prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
                            demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted)
+        # cells closed by contact in the last step (held at w = 0, opened before now) start closed
+        closed = (w_old <= 0.0) & (tau < self.t) if pinned is None else None
         with blas_threads(self.ix.size):
             res = solve_step(prob, self.elastic, self.num.newton_tolerance, self.num.newton_max_iterations,
-                             None if w_start is None else np.where(w_start > 0.0, w_start, start_widths(prob)))
+                             None if w_start is None else np.where(w_start > 0.0, w_start, start_widths(prob)),
+                             closed)
         self.newton_iterations += res.iterations
         return res
 
@@ -552,7 +554,8 @@ class _Engine:
         return BalanceRecord(time=self.t, injected=injected, stored=stored, leaked=self.leaked_total,
                              injection_pressure=pressure, net_pressure=pressure - float(self.sigma_a[self.inj]),
                              efficiency=stored / injected if injected > 0.0 else math.nan, area=size["area"],
-                             length=size["length"], height=size["height"])
+                             length=size["length"], height=size["height"],
+                             inlet_width=float(g["w"][self.rows[self.inj], self.cols[self.inj]]))
 
     def now(self) -> _View:
         """The current state as a :class:`_View`."""
@@ -587,7 +590,9 @@ class _Engine:
         """Area, equal-area radius, length and height of the footprint, tip cells by their filled fraction
         (geometry.py)."""
         g = view.grid
-        fraction = filled_fraction(self.num.front_tracking, g["active"], g["fill"], g["opened"], g["filled"], view.t)
+        distances = None if self.num.front_tracking == "subgrid" else front_distances(
+            self.tip, g["active"], g["w"], g["p"], view.kprime_box, view.cprime_box, g["reached"], view.t, g.dx, g.dz)
+        fraction = filled_fraction(self.num.front_tracking, g["active"], g["fill"], distances, g.dx, g.dz)
         return footprint(fraction, g.dx, g.dz)
 
     def front(self, view: _View) -> dict:

@@ -63,7 +63,7 @@ UNITS = {
     "scene": "",
     # the fracture engine's scalar snapshot extras (docs/results-format.md)
     **{f"front_{k}": "m" for k in ("radius", "radius_min", "radius_max", "up", "down", "left", "right")},
-    "area": "m^2", "area_radius": "m", "length": "m", "height": "m",
+    "area": "m^2", "area_radius": "m", "inlet_width": "m", "length": "m", "height": "m",
     "injected_volume": "m^3", "stored_volume": "m^3", "leaked_volume": "m^3",
     # /closure (hfgpu.closure.conductivity.ClosureMap.fields)
     "propped_width": "m", "conductivity": "m^3", "closure_stress": "Pa", "permeability": "m^2",
@@ -73,7 +73,7 @@ UNKNOWN_UNITS = "unspecified"
 
 FRACTURE_FIELDS = ("width", "pressure", "leakoff_rate", "opening_time")
 FRACTURE_BALANCE = ("time", "injected", "stored", "leaked", "injection_pressure", "net_pressure", "efficiency",
-                    "area", "length", "height")
+                    "area", "length", "height", "inlet_width")
 PROPPANT_BALANCE = ("time", "injected", "in_domain", "outflow", "screened_out")
 _BALANCE_FLUSH_ROWS = 4096
 _COMPRESS_ABOVE = 4096  # elements; smaller arrays are stored plainly

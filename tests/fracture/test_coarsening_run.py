@@ -41,13 +41,15 @@ def test_volume_balance_holds_across_coarsening_and_footprint_stays_capped():
 
 @pytest.mark.slow
 def test_long_storage_viscosity_radial_case_with_coarsening():
-    """radial_long.toml: 0.1 m cells to 1e5 s (R ~ 270 m), five 3x3 merges; radius and inlet width vs
-    Dontsov (2016). Measured: R +2.8 % (min/max front +1.4 / +3.9 %), w(0) -3.6 %, ~9 s; the 2.2 % goal is not met."""
+    """radial_long.toml: 0.1 m cells to 1e5 s (R ~ 270 m), five 3x3 merges at 24 cells across, universal tip
+    asymptote; radius from the area, front radius and inlet width vs Dontsov (2016). Measured: R from the
+    area -0.54 %, front -0.22 %, w(0) -0.06 %, 129 steps, ~4 s (issue 19's goal at the end: 1 %)."""
     sc = load_scene(SCENES / "radial_long.toml")
     out = simulate(sc, MemorySink())
     rock, q, end = sc.rock, sc.injection.schedule.stages[0].rate, sc.run.end_time
     ref = dontsov_radial(rock.plane_strain_modulus, math.sqrt(32 / math.pi) * rock.toughness,
                          12 * sc.fluid.viscosity, 0.0, q, end)
     assert out["coarsenings"] == 5 and out["max_balance_error"] < 1e-9
-    assert out["radius"] == pytest.approx(float(ref.R[-1]), rel=0.035)
-    assert out["w_inlet"] == pytest.approx(float(ref.w0[-1]), rel=0.05)
+    assert out["area_radius"] == pytest.approx(float(ref.R[-1]), rel=0.01)
+    assert out["radius"] == pytest.approx(float(ref.R[-1]), rel=0.01)
+    assert out["w_inlet"] == pytest.approx(float(ref.w0[-1]), rel=0.01)

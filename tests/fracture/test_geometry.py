@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from hfgpu.fracture.front import DIRECTIONS, _shift
 from hfgpu.fracture.geometry import filled_fraction, footprint
 from hfgpu.fracture.simulator import simulate
 from hfgpu.fracture.tip_cells import wetted_fraction
@@ -15,18 +16,38 @@ from hfgpu.records import MemorySink
 from .helpers import scene
 
 
+def _edge_distances(active: np.ndarray, s: float) -> list[np.ndarray]:
+    """front.front_distances' layout with the same distance s at every side that faces a closed cell."""
+    return [np.where(active & ~_shift(active, -dk, -di, False), s, np.nan) for dk, di in DIRECTIONS]
+
+
 @pytest.mark.parametrize("mode", ["cells", "subgrid"])
 def test_fully_open_rectangle_to_round_off(mode):
     dx, dz, nx, nz = 0.3, 0.7, 11, 7
     active = np.zeros((nz + 4, nx + 6), bool)
     active[2:2 + nz, 3:3 + nx] = True
-    opened = np.where(active, 1.0, np.nan)
-    fraction = filled_fraction(mode, active, np.where(active, 1.0, 0.0), opened, opened + 2.0, 5.0)
+    # cells: the front one cell past every edge cell's centre (the cap), i.e. at or past its outer faces
+    fraction = filled_fraction(mode, active, np.where(active, 1.0, 0.0), _edge_distances(active, 0.7), dx, dz)
     size = footprint(fraction, dx, dz)
     assert size["area"] == pytest.approx(nx * nz * dx * dz, rel=1e-15)
     assert size["length"] == pytest.approx(nx * dx, rel=1e-15)
     assert size["height"] == pytest.approx(nz * dz, rel=1e-15)
     assert size["area_radius"] == pytest.approx(math.sqrt(nx * nz * dx * dz / math.pi), rel=1e-15)
+
+
+def test_cells_front_fraction_is_the_part_behind_the_reconstructed_front():
+    dx, dz = 2.0, 1.0
+    active = np.zeros((5, 7), bool)
+    active[1:4, 1:6] = True
+    fraction = filled_fraction("cells", active, np.zeros(active.shape), _edge_distances(active, 0.25), dx, dz)
+    # a side cell: 1/2 + s / h across its facing side; a corner: the diagonal cut (normal (1, 1)/sqrt 2) at
+    # s = 0.25 past the centre, tip_cells.wetted_fraction; inside 1, outside 0
+    assert fraction[2, 1] == pytest.approx(0.5 + 0.25 / dx, rel=1e-6)
+    assert fraction[1, 3] == pytest.approx(0.5 + 0.25 / dz, rel=1e-6)
+    n = 1.0 / math.sqrt(2.0)
+    corner = float(wetted_fraction(np.array([0.25]), np.array([-n]), np.array([-n]), dx, dz)[0])
+    assert fraction[1, 1] == pytest.approx(corner, rel=1e-12) and 0.5 < corner < 1.0
+    assert fraction[2, 3] == 1.0 and fraction[0].sum() == 0.0 and fraction[:, 0].sum() == 0.0
 
 
 def _circle(cells_per_radius: int, radius: float = 10.0):
@@ -52,14 +73,6 @@ def test_circular_front_converges_at_second_order():
     assert size["length"] == pytest.approx(20.0, rel=1e-12) and size["height"] == pytest.approx(20.0, rel=1e-12)
 
 
-def test_cells_front_counts_a_tip_cell_by_the_time_the_front_takes_to_cross_it():
-    active = np.array([[True, True, True, False]])
-    opened = np.array([[0.0, 4.0, 10.0, np.nan]])
-    filled = np.array([[0.0, 8.0, 14.0, np.nan]])   # the first: the starting fracture (filled = opened)
-    fraction = filled_fraction("cells", active, np.zeros((1, 4)), opened, filled, 11.0)
-    np.testing.assert_allclose(fraction, [[1.0, 1.0, 0.25, 0.0]], rtol=1e-15)
-
-
 @pytest.mark.parametrize("front", ["cells", "subgrid"])
 def test_a_run_reports_its_footprint_in_the_summary_and_every_snapshot(front):
     sc = scene(end_time="100 s", cell="1 m", every="25 s", fracture=f'[fracture]\nfront_tracking = "{front}"')
@@ -73,5 +86,7 @@ def test_a_run_reports_its_footprint_in_the_summary_and_every_snapshot(front):
     assert out["length"] == pytest.approx(2.0 * out["area_radius"], rel=0.1)
     assert out["height"] == pytest.approx(out["length"], rel=1e-9)
     assert out["area"] <= out["cells"] * 1.0
+    if front == "cells":   # the area comes from the same reconstructed front as the front summary
+        assert out["area_radius"] == pytest.approx(out["radius"], rel=0.02)
     areas = [float(s.extras["area"]) for s in sink.fracture_snapshots]
     assert areas == sorted(areas)

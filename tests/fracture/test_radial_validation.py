@@ -4,7 +4,7 @@ vertex closed forms (Savitski & Detournay 2002; REFERENCE.md 1.1, 1.3), via hfgp
 Default runs are coarse (about 20-25 cells across the final diameter); tolerances reflect that. The
 refinement series and the 2 % (radius) / 5 % (inlet width) goals are marked slow. R is the front's mean
 radius (the summary's ``radius``); R_area = sqrt(area / pi), the radius of the footprint's area with tip cells
-counted by their filled fraction (geometry.py), is what the sub-grid front's checks use (test_subgrid_front.py).
+counted by their filled fraction (geometry.py).
 """
 
 import dataclasses
@@ -41,9 +41,9 @@ def run_case(name: str, cell: float | None = None, **numerics):
 
 def test_case_I_storage_viscosity_coarse():
     out, sink, err, (e, mu, k, q, t) = run_case("I")            # 5 m cells, ~22 across
-    # measured: front's mean radius +0.22 %, from the area -3.55 % (the cells front counts its last rings of
-    # cells by the time the front takes to cross them, geometry.py), w0 +0.67 %
-    assert abs(err["R"]) < 0.06 and abs(err["R_area"]) < 0.06 and abs(err["w0"]) < 0.04, err
+    # measured: front's mean radius +0.22 %, from the area -0.73 % (the edge cells counted by the part behind
+    # the front reconstructed from their widths, geometry.py), w0 +0.67 %
+    assert abs(err["R"]) < 0.06 and abs(err["R_area"]) < 0.015 and abs(err["w0"]) < 0.04, err
     vertex = m_vertex(e, mu, q, t)                                 # the case sits at the M vertex
     assert out["radius"] == pytest.approx(float(vertex.R), rel=0.06)
     assert out["max_balance_error"] < 1e-3
@@ -52,6 +52,7 @@ def test_case_I_storage_viscosity_coarse():
 def test_case_III_storage_toughness_coarse():
     out, sink, err, (e, mu, k, q, t) = run_case("III")          # 0.25 m cells, ~22 across
     assert abs(err["R"]) < 0.02 and abs(err["w0"]) < 0.06, err
+    assert abs(err["R_area"]) < 0.03, err                          # measured -2.02 %
     vertex = k_vertex(e, k, q, t)
     assert out["w_inlet"] == pytest.approx(float(vertex.w0), rel=0.07)
     assert out["max_balance_error"] < 1e-3
@@ -61,7 +62,7 @@ def test_case_II_leakoff_viscosity_coarse():
     # measured R +3.6 %, w0 -4.4 % at 0.5 m cells (~11 per final radius) with the leak-off clock (leakoff.py);
     # without it R +8.0 %, w0 -3.0 %: cells held dry by the ramp lost their Carter exposure for good
     out, sink, err, _ = run_case("II", front_tracking="cells")
-    assert abs(err["R"]) < 0.05 and abs(err["w0"]) < 0.05, err
+    assert abs(err["R"]) < 0.05 and abs(err["R_area"]) < 0.05 and abs(err["w0"]) < 0.05, err   # R_area +3.36 %
     assert out["max_balance_error"] < 1e-3
 
 
@@ -130,12 +131,3 @@ def test_case_IV_leakoff_toughness_finishes_with_the_balance_with_the_cell_by_ce
     out, _, err, _ = run_case("IV", 0.035, front_tracking="cells")
     assert out["time"] == pytest.approx(407.0) and out["max_balance_error"] < 1e-9
     assert abs(err["R"]) < 0.10, err
-
-
-@pytest.mark.slow
-def test_long_run_meets_the_goal_with_the_universal_tip_asymptote():
-    # radial_long.toml (0.1 m cells to 1e5 s, coarsened at 40 cells across): tip_asymptote = "universal"
-    # measured R -0.81 %, w0 -0.03 % in 203 steps (the default "km" envelope: +2.95 %, -3.6 %): the envelope
-    # max(w_k, w_m) is narrower than the universal K-M asymptote in the transition the run crosses
-    _, _, err, _ = run_case("long", tip_asymptote="universal")
-    assert abs(err["R"]) < 0.02 and abs(err["w0"]) < 0.05, err

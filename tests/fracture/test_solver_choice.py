@@ -1,0 +1,83 @@
+"""Which linear solver "auto" picks (solver_choice.py), the krylov_threshold contract, Jacobian reuse in Newton,
+and that the choice is deterministic (same results on rerun)."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from hfgpu.fracture import newton
+from hfgpu.fracture.elasticity import ElasticityOperator
+from hfgpu.fracture.lubrication import build_faces
+from hfgpu.fracture.newton import Elasticity, StepProblem, solve_step
+from hfgpu.fracture.simulator import simulate
+from hfgpu.fracture.solver_choice import MODEL, footprint_measures, use_dense
+from hfgpu.records import MemorySink
+
+from .helpers import scene
+
+
+def _ellipse(n, aspect):
+    b = np.sqrt(n / (np.pi * aspect))
+    a = aspect * b
+    ix, iz = np.meshgrid(np.arange(-int(a) - 1, int(a) + 2), np.arange(-int(b) - 1, int(b) + 2))
+    keep = (ix / a) ** 2 + (iz / b) ** 2 < 1.0
+    return ix[keep].astype(np.int64), iz[keep].astype(np.int64)
+
+
+def test_forced_solvers_and_the_fixed_count_rule():
+    ix, iz = _ellipse(1000, 20.0)
+    assert use_dense("direct", None, ix, iz) and not use_dense("krylov", None, ix, iz)
+    assert use_dense("direct", 10, ix, iz) and not use_dense("krylov", 10**6, ix, iz)
+    assert use_dense("auto", ix.size + 1, ix, iz) and not use_dense("auto", ix.size, ix, iz)
+
+
+def test_cost_model_prefers_dense_on_small_radial_and_krylov_on_elongated_footprints():
+    assert use_dense("auto", None, *_ellipse(300, 1.0))
+    assert not use_dense("auto", None, *_ellipse(1500, 20.0))
+    assert not use_dense("auto", None, *_ellipse(8000, 1.0))
+    # the crossover comes at fewer cells the more elongated the footprint
+    def crossover(aspect):
+        return next(n for n in range(100, 20000, 100) if MODEL.prefers_krylov(footprint_measures(*_ellipse(n, aspect))))
+    assert crossover(20.0) < crossover(5.0) <= crossover(1.0)
+
+
+def test_krylov_threshold_is_optional_and_still_accepted():
+    assert scene().fracture.krylov_threshold is None
+    assert scene(fracture="[fracture]\nkrylov_threshold = 300").fracture.krylov_threshold == 300
+
+
+def _step():
+    ix, iz = _ellipse(400, 5.0)
+    h = 0.2
+    op = ElasticityOperator(h, h, 3.7e10)
+    a, b = np.abs(ix).max() + 0.5, np.abs(iz).max() + 0.5
+    w_old = 1e-3 * np.sqrt(np.clip(1 - (ix / a) ** 2 - (iz / b) ** 2, 0, None))
+    dt = 3e3 * 0.0132 * h**3 / (1e-9 * 3.7e10)
+    source = np.where((ix == 0) & (iz == 0), 1e-3 * dt, 0.0)
+    prob = StepProblem(ix, iz, w_old, np.full(ix.size, 1e6), build_faces(ix, iz, h, h, 0.0132), h * h, dt,
+                       source, np.zeros(ix.size), np.full(ix.size, 1e-5), 1e-6)
+    return prob, op
+
+
+@pytest.mark.parametrize("dense", [True, False])
+def test_jacobian_reuse_keeps_the_solution_and_saves_factorisations(dense, monkeypatch):
+    prob, op = _step()
+    results = {}
+    for reuse in (False, True):
+        monkeypatch.setattr(newton, "REUSE_JACOBIAN", reuse)
+        newton.COUNTS.reset()
+        res = solve_step(prob, Elasticity(op, prob.ix, prob.iz, dense), 1e-8, 30)
+        assert res.converged
+        results[reuse] = res, newton.COUNTS.factorisations
+    (plain, f_plain), (reused, f_reused) = results[False], results[True]
+    np.testing.assert_allclose(reused.w, plain.w, rtol=0, atol=1e-6 * np.abs(plain.w).max())
+    assert f_reused <= f_plain
+
+
+def test_auto_choice_is_deterministic():
+    sc = scene(end_time="30 s", cell="1 m")
+    a, b = simulate(sc, MemorySink()), simulate(sc, MemorySink())
+    assert a == b
+    forced = simulate(sc.replace(fracture=dataclasses.replace(sc.fracture, linear_solver="direct")), MemorySink())
+    assert forced["cells"] == a["cells"]
