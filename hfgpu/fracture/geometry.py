@@ -25,6 +25,9 @@ How each front gives f (``filled_fraction``):
   the front agree (radial_long, universal tip: R from the area -0.5 %, from the front -0.2 % at 1e5 s;
   ``python bench/bench_fracture.py --cases long``).
 
+Cells that contact holds shut (width 0 after their opening, newton.py) hold no fluid and count 0 in either
+mode: a barrier row that the front opened and the stress closed again is not fracture area.
+
 The fluid volume of the footprint is V = dx dz sum_cells w: a tip cell's width is its cell mean (the tip
 asymptote's mean over the wetted part with the sub-grid front), so V is the stored volume of the balance.
 """
@@ -40,11 +43,14 @@ from .tip_cells import wetted_fraction
 
 
 def filled_fraction(mode: str, active: np.ndarray, fill: np.ndarray, distances: list[np.ndarray] | None,
-                    dx: float, dz: float) -> np.ndarray:
-    """Filled fraction f of every box cell (module docstring), 0 outside the footprint ``active``; ``mode`` is
+                    dx: float, dz: float, shut: np.ndarray | None = None) -> np.ndarray:
+    """Filled fraction f of every box cell (module docstring), 0 outside the footprint ``active`` and in the
+    cells ``shut`` (held closed by contact: no fluid, not part of the fracture's area); ``mode`` is
     ``front_tracking``; ``fill``: the sub-grid front's wetted fractions; ``distances``: with cells, the front's
     distance from each edge cell's centre per side facing a closed cell (front.front_distances, in the order
     of front.DIRECTIONS; NaN elsewhere)."""
+    if shut is not None:
+        active = active & ~shut
     if mode == "subgrid":
         return np.where(active, np.clip(fill, 0.0, 1.0), 0.0)
     nx, nz = np.zeros(active.shape), np.zeros(active.shape)

@@ -592,7 +592,8 @@ class _Engine:
         g = view.grid
         distances = None if self.num.front_tracking == "subgrid" else front_distances(
             self.tip, g["active"], g["w"], g["p"], view.kprime_box, view.cprime_box, g["reached"], view.t, g.dx, g.dz)
-        fraction = filled_fraction(self.num.front_tracking, g["active"], g["fill"], distances, g.dx, g.dz)
+        shut = (g["w"] <= 0.0) & (g["opened"] < view.t)   # held closed by contact, not just opened
+        fraction = filled_fraction(self.num.front_tracking, g["active"], g["fill"], distances, g.dx, g.dz, shut)
         return footprint(fraction, g.dx, g.dz)
 
     def front(self, view: _View) -> dict:

@@ -48,6 +48,12 @@ def test_cells_front_fraction_is_the_part_behind_the_reconstructed_front():
     corner = float(wetted_fraction(np.array([0.25]), np.array([-n]), np.array([-n]), dx, dz)[0])
     assert fraction[1, 1] == pytest.approx(corner, rel=1e-12) and 0.5 < corner < 1.0
     assert fraction[2, 3] == 1.0 and fraction[0].sum() == 0.0 and fraction[:, 0].sum() == 0.0
+    # a cell held shut by contact holds no fluid: it counts 0, in either mode
+    shut = np.zeros(active.shape, bool)
+    shut[2, 1] = True
+    for mode in ("cells", "subgrid"):
+        held = filled_fraction(mode, active, np.ones(active.shape), _edge_distances(active, 0.25), dx, dz, shut)
+        assert held[2, 1] == 0.0 and held[2, 3] == 1.0
 
 
 def _circle(cells_per_radius: int, radius: float = 10.0):
