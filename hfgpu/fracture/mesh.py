@@ -70,6 +70,11 @@ class Grid:
         rows, cols = np.nonzero(self.fields["active"])
         return rows, cols, cols + self.ix0, rows + self.iz0
 
+    def shut(self, t: float) -> np.ndarray:
+        """Active cells held closed by contact at time t: width 0 after their opening (a cell opened at t itself
+        has not been solved yet). They start a step closed (newton.solve_step) and count no area (geometry.py)."""
+        return self.fields["active"] & (self.fields["w"] <= 0.0) & (self.fields["opened"] < t)
+
     def ensure_margin(self, margin: int = 2) -> None:
         """Grow the box by GROW cells on every side an active cell comes within ``margin`` cells of."""
         rows, cols = np.nonzero(self.fields["active"])

@@ -291,8 +291,7 @@ class _Engine:
         w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
         prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
                            demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted)
-        # cells closed by contact in the last step (held at w = 0, opened before now) start closed
-        closed = (w_old <= 0.0) & (tau < self.t) if pinned is None else None
+        closed = g.shut(self.t)[sel] if pinned is None else None   # the last step's contact set
         with blas_threads(self.ix.size):
             res = solve_step(prob, self.elastic, self.num.newton_tolerance, self.num.newton_max_iterations,
                              None if w_start is None else np.where(w_start > 0.0, w_start, start_widths(prob)),
@@ -549,13 +548,14 @@ class _Engine:
         g = self.grid
         stored = float(g["w"][g["active"]].sum()) * self.area
         injected = self.schedule.volume(self.t)
-        pressure = float(g["p"][self.rows[self.inj], self.cols[self.inj]])
+        inlet = (self.rows[self.inj], self.cols[self.inj])
+        pressure = float(g["p"][inlet])
         size = self.geometry(self.now())
         return BalanceRecord(time=self.t, injected=injected, stored=stored, leaked=self.leaked_total,
                              injection_pressure=pressure, net_pressure=pressure - float(self.sigma_a[self.inj]),
                              efficiency=stored / injected if injected > 0.0 else math.nan, area=size["area"],
                              length=size["length"], height=size["height"],
-                             inlet_width=float(g["w"][self.rows[self.inj], self.cols[self.inj]]))
+                             inlet_width=float(g["w"][inlet]))
 
     def now(self) -> _View:
         """The current state as a :class:`_View`."""
@@ -592,8 +592,8 @@ class _Engine:
         g = view.grid
         distances = None if self.num.front_tracking == "subgrid" else front_distances(
             self.tip, g["active"], g["w"], g["p"], view.kprime_box, view.cprime_box, g["reached"], view.t, g.dx, g.dz)
-        shut = (g["w"] <= 0.0) & (g["opened"] < view.t)   # held closed by contact, not just opened
-        fraction = filled_fraction(self.num.front_tracking, g["active"], g["fill"], distances, g.dx, g.dz, shut)
+        fraction = filled_fraction(self.num.front_tracking, g["active"], g["fill"], distances, g.dx, g.dz,
+                                   g.shut(view.t))
         return footprint(fraction, g.dx, g.dz)
 
     def front(self, view: _View) -> dict:
@@ -733,12 +733,10 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
             dt = eng.next_dt(dt if taken == step else taken)
             if checkpoint is not None and checkpoint.due(eng.t):
                 checkpoint.save(eng.t, {"engine": eng.state(), "dt": dt, "target": index})
-    g = eng.grid
-    inj = (eng.rows[eng.inj], eng.cols[eng.inj])
     final = eng.balance()
     return dict(time=eng.t, t0=eng.t0, steps=eng.steps, newton_iterations=eng.newton_iterations,
                 retries=eng.retries, rejected=eng.rejected, coarsenings=eng.coarsenings, dx=eng.dx, dz=eng.dz,
-                cells=int(g["active"].sum()), w_inlet=float(g["w"][inj]),
-                p_inlet=float(g["p"][inj]), injected=final.injected, stored=final.stored,
+                cells=int(eng.grid["active"].sum()), w_inlet=final.inlet_width,
+                p_inlet=final.injection_pressure, injected=final.injected, stored=final.stored,
                 leaked=final.leaked, max_balance_error=eng.max_balance_error, **eng.front(eng.now()),
                 **eng.geometry(eng.now()))
