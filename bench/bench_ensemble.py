@@ -45,10 +45,10 @@ def main() -> None:
                         "base case (docs/field-case.md: about 3.5 min)")
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    text = SCENE.read_text(encoding="utf-8")
+    scene = hfgpu.load_scene(SCENE)
     if args.preset:
-        text = text.replace("[run]\n", f'[run]\npreset = "{args.preset}"\n', 1)
-    (args.out / "base.toml").write_text(text, encoding="utf-8")
+        scene = hfgpu.edit_scene(scene, {"run.preset": args.preset})
+    (args.out / "base.toml").write_text(scene.source, encoding="utf-8")
     (args.out / "sweep.toml").write_text(SWEEP.format(members=args.members), encoding="utf-8")
     walls = {}
     for workers in args.workers:

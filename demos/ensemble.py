@@ -52,10 +52,10 @@ high = "420 um"
 
 
 def base_scene() -> str:
-    """The demo scene at the fast preset, its sieve class replaced by one diameter."""
-    text = SCENE.read_text(encoding="utf-8")
-    text = text.replace("[run]\n", '[run]\npreset = "fast"\n', 1)
-    return text.replace('size = "40/70"', 'diameter = "300 um"', 1)
+    """TOML text of the demo scene at the fast preset, its sieve class replaced by one diameter."""
+    edited = hfgpu.edit_scene(hfgpu.load_scene(SCENE), {"run.preset": "fast", "proppant[0].size": None,
+                                                        "proppant[0].diameter": "300 um"})
+    return edited.source
 
 
 def main() -> None:
