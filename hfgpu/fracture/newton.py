@@ -87,6 +87,21 @@ class StepProblem:
     wetted: np.ndarray | None = None   # wetted fraction of each cell's area that leaks (None: all of it)
 
 
+@dataclass
+class NewtonWork:
+    """Work of Newton solves: iterations that solved for an update, factorisations (dense LU or the Krylov
+    preconditioner's SuperLU) and GMRES iterations."""
+
+    iterations: int = 0
+    factorisations: int = 0
+    gmres_iterations: int = 0
+
+    def add(self, other: "NewtonWork") -> None:
+        self.iterations += other.iterations
+        self.factorisations += other.factorisations
+        self.gmres_iterations += other.gmres_iterations
+
+
 @dataclass(frozen=True)
 class StepResult:
     w: np.ndarray
@@ -95,6 +110,7 @@ class StepResult:
     iterations: int
     converged: bool
     residual: np.ndarray      # final Eq. 29 residual per cell [m^3]
+    work: NewtonWork          # the step's linear-algebra work (all contact passes)
 
 
 class Elasticity:
@@ -217,22 +233,10 @@ def _krylov_update(prob, elastic, f, lap, cond, diag, rtol, closed, precond=None
     return result.x, precond, result.iterations
 
 
-class NewtonCounts:
-    """Work counters of the Newton solves (module-level COUNTS; benchmarks read and reset them)."""
-
-    def __init__(self):
-        self.reset()
-
-    def reset(self) -> None:
-        self.iterations = self.factorisations = self.gmres_iterations = 0
-
-
-COUNTS = NewtonCounts()
-
-
 def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray, tolerance: float,
-            max_iterations: int) -> tuple[np.ndarray, bool, int]:
-    """Damped Newton on Eq. 29 for a fixed contact set (module docstring); (x, converged, iterations).
+            max_iterations: int, work: NewtonWork) -> tuple[np.ndarray, bool, int]:
+    """Damped Newton on Eq. 29 for a fixed contact set (module docstring); (x, converged, iterations), the
+    work done added to ``work``.
 
     Jacobian reuse: the monotonicity test of an undamped update already gives the simplified Newton
     correction at the new iterate with the current factorisation, dx' = -J_k^-1 F(x + dx). When it contracts
@@ -258,16 +262,17 @@ def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nd
                         warnings.simplefilter("error", scipy.linalg.LinAlgWarning)
                         lu = scipy.linalg.lu_factor(_dense(prob, elastic, lap, cond, diag, closed),
                                                     check_finite=False)
-                    COUNTS.factorisations += 1
+                    work.factorisations += 1
                     dx = scipy.linalg.lu_solve(lu, -r.f)
                     inverse = partial(scipy.linalg.lu_solve, lu)
                 else:
-                    dx, precond = _gmres_update(prob, elastic, r.f, lap, cond, diag, tolerance, closed, precond)
+                    dx, precond = _gmres_update(prob, elastic, r.f, lap, cond, diag, tolerance, closed, precond,
+                                                work)
                     dx = _volume_exact(prob, r, dx, closed)
                     inverse = precond.matvec
         except (np.linalg.LinAlgError, ValueError, scipy.linalg.LinAlgWarning):
             return x, False, it
-        COUNTS.iterations += 1
+        work.iterations += 1
         if not np.all(np.isfinite(dx)):
             return x, False, it
         scale = np.linalg.norm(dx) if dense else np.linalg.norm(inverse(-r.f))
@@ -309,20 +314,20 @@ def _volume_exact(prob: StepProblem, r: Residual, dx: np.ndarray, closed: np.nda
     return dx - np.where(closed, 0.0, (r.f.sum() + a @ dx) / total)
 
 
-def _gmres_update(prob, elastic, f, lap, cond, diag, tolerance, closed, precond):
+def _gmres_update(prob, elastic, f, lap, cond, diag, tolerance, closed, precond, work: NewtonWork):
     """(dx, M) by _krylov_update with M reused when given; a GMRES that fails with a reused M is rerun with
-    a new one."""
+    a new one (its work added to ``work``)."""
     rtol = min(1e-3, tolerance * GMRES_TOLERANCE_FACTOR)
     if precond is not None:
         try:
             dx, precond, gm = _krylov_update(prob, elastic, f, lap, cond, diag, rtol, closed, precond)
-            COUNTS.gmres_iterations += gm
+            work.gmres_iterations += gm
             return dx, precond
         except np.linalg.LinAlgError:
             pass
-    COUNTS.factorisations += 1
+    work.factorisations += 1
     dx, precond, gm = _krylov_update(prob, elastic, f, lap, cond, diag, rtol, closed)
-    COUNTS.gmres_iterations += gm
+    work.gmres_iterations += gm
     return dx, precond
 
 
@@ -350,8 +355,9 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
     if closed.any():   # a held cell's unknown starts at the elastic pressure of the start widths
         x[closed] = elastic.apply(np.where(closed, held_width(prob), x))[closed] / elastic.self_stiffness
     iterations = 0
+    work = NewtonWork()
     for _ in range(CONTACT_PASSES):
-        x, converged, it = _newton(prob, elastic, x, closed, tolerance, max_iterations)
+        x, converged, it = _newton(prob, elastic, x, closed, tolerance, max_iterations, work)
         iterations += it
         if not converged:
             break
@@ -365,4 +371,4 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
     r = residual(prob, elastic, x, closed)
     ok = converged and bool(np.all(np.isfinite(r.f)))
     return StepResult(w=r.w, p=r.p, leaked=prob.area * prob.demand * r.g, iterations=iterations, converged=ok,
-                      residual=r.f)
+                      residual=r.f, work=work)

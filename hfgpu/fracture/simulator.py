@@ -220,6 +220,7 @@ class _Engine:
         self.v_front = power * r0 / self.t0
         self.t_front = self.t0
         self.steps = self.newton_iterations = self.retries = self.rejected = self.coarsenings = 0
+        self.factorisations = self.gmres_iterations = 0
         self.v_tip = 0.0
         self.dt_failed = math.inf   # the last step whose Newton failed, released step by step (next_dt)
         self.max_balance_error = 0.0
@@ -243,6 +244,7 @@ class _Engine:
         sel = (self.rows, self.cols)
         self.sigma_a, self.cprime_a = self.sigma_box[sel], self.cprime_box[sel]
         self.inj = int(np.flatnonzero((self.ix == 0) & (self.iz == 0))[0])
+        self.distances = None
 
     # ------------------------------------------------------------------------------------------
     def step(self, dt: float, keep_ends: bool = False) -> float:
@@ -253,7 +255,7 @@ class _Engine:
             return self._step_subgrid(dt, keep_ends)
         g = self.grid
         start = g.copy() if keep_ends else None
-        reach_old = self._front_reach(g["w"], g["p"], self.t)
+        reach_old = self._front_reach(self.distances_now())
         h = min(self.dx, self.dz)
         for attempt in range(self.num.max_step_retries + 1):
             res = self._solve(dt)
@@ -297,6 +299,8 @@ class _Engine:
                              None if w_start is None else np.where(w_start > 0.0, w_start, start_widths(prob)),
                              closed)
         self.newton_iterations += res.iterations
+        self.factorisations += res.work.factorisations
+        self.gmres_iterations += res.work.gmres_iterations
         return res
 
     def _newton_retry(self, dt: float) -> None:
@@ -321,6 +325,7 @@ class _Engine:
         self.t += dt
         g["w"][sel] = res.w
         g["p"][sel] = res.p
+        self.distances = None
         g["leak_rate"][sel] = res.leaked / (self.area * dt)
         g["leaked"][sel] = g["leaked"][sel] + res.leaked / self.area
         self.leaked_total += float(res.leaked.sum())
@@ -461,13 +466,20 @@ class _Engine:
         self._properties()
         self._rebuild()
 
-    def _front_reach(self, w: np.ndarray, p: np.ndarray, t: float) -> np.ndarray:
+    def distances_now(self) -> list[np.ndarray]:
+        """front.front_distances of the current state (per side, from each edge cell's centre to the front),
+        computed once per state: the balance's area, the front summary and the next step's front reach share
+        them (any change of the widths or of the active set clears them)."""
+        if self.distances is None:
+            g = self.grid
+            self.distances = front_distances(self.tip, g["active"], g["w"], g["p"], self.kprime_box,
+                                             self.cprime_box, g["reached"], self.t, self.dx, self.dz)
+        return self.distances
+
+    def _front_reach(self, distances: list[np.ndarray]) -> np.ndarray:
         """Largest sub-grid front distance s (Eq. 33 inverted, front.front_distances) of every box cell,
         capped at 2 cells; 0 where a cell faces no inactive cell."""
-        g = self.grid
-        dist = front_distances(self.tip, g["active"], w, p, self.kprime_box, self.cprime_box, g["reached"], t,
-                               self.dx, self.dz)
-        return np.minimum(np.nan_to_num(np.fmax.reduce(dist), nan=0.0), 2.0 * max(self.dx, self.dz))
+        return np.minimum(np.nan_to_num(np.fmax.reduce(distances), nan=0.0), 2.0 * max(self.dx, self.dz))
 
     def _front_advance(self, reach_old: np.ndarray, w: np.ndarray, p: np.ndarray, t: float) -> float:
         """Largest distance any front point moved over a step that ends at t with active widths w and
@@ -475,7 +487,9 @@ class _Engine:
         g, sel = self.grid, (self.rows, self.cols)
         w_box, p_box = g["w"].copy(), g["p"].copy()
         w_box[sel], p_box[sel] = w, p
-        return float(np.max(self._front_reach(w_box, p_box, t) - reach_old))
+        reach = self._front_reach(front_distances(self.tip, g["active"], w_box, p_box, self.kprime_box,
+                                                  self.cprime_box, g["reached"], t, self.dx, self.dz))
+        return float(np.max(reach - reach_old))
 
     def _advance_front(self) -> None:
         """Open the cells the front criterion selects (Eq. 33) and record the tip speed (Eq. 34)."""
@@ -586,12 +600,19 @@ class _Engine:
             opening_time=np.where(act, g["opened"][rs, cs], np.nan),
             extras={k: np.array(v) for k, v in scalars.items()})
 
+    def _view_distances(self, view: _View) -> list[np.ndarray]:
+        """front.front_distances of ``view``: the shared ones (``distances_now``) when it is the current state."""
+        if view.grid is self.grid and view.t == self.t:
+            return self.distances_now()
+        g = view.grid
+        return front_distances(self.tip, g["active"], g["w"], g["p"], view.kprime_box, view.cprime_box,
+                               g["reached"], view.t, g.dx, g.dz)
+
     def geometry(self, view: _View) -> dict:
         """Area, equal-area radius, length and height of the footprint, tip cells by their filled fraction
         (geometry.py)."""
         g = view.grid
-        distances = None if self.num.front_tracking == "subgrid" else front_distances(
-            self.tip, g["active"], g["w"], g["p"], view.kprime_box, view.cprime_box, g["reached"], view.t, g.dx, g.dz)
+        distances = None if self.num.front_tracking == "subgrid" else self._view_distances(view)
         fraction = filled_fraction(self.num.front_tracking, g["active"], g["fill"], distances, g.dx, g.dz,
                                    g.shut(view.t))
         return footprint(fraction, g.dx, g.dz)
@@ -615,8 +636,7 @@ class _Engine:
             radii = np.hypot(px, pz)
             ext = dict(right=px.max(), left=-px.min(), down=pz.max(), up=-pz.min())
         else:
-            dist = front_distances(self.tip, g["active"], g["w"], g["p"], view.kprime_box, view.cprime_box,
-                                   g["reached"], view.t, dx, dz)
+            dist = self._view_distances(view)
             best = np.zeros(xo.shape)
             ext = {}
             for name, (dk, di), s in zip(("right", "left", "down", "up"), DIRECTIONS, dist):
@@ -632,7 +652,8 @@ class _Engine:
     # -- checkpoints ------------------------------------------------------------------------------
     #: Attributes (numbers or arrays) a checkpoint carries besides the grid: list every new persistent one here.
     STATE_ATTRIBUTES = ("t", "t0", "v_front", "t_front", "leaked_total", "steps", "newton_iterations", "retries",
-                        "coarsenings", "max_balance_error", "v_tip", "rejected", "dt_failed")
+                        "coarsenings", "max_balance_error", "v_tip", "rejected", "dt_failed", "factorisations",
+                        "gmres_iterations")
 
     def state(self) -> dict:
         """Everything needed to continue from now (a checkpoint): STATE_ATTRIBUTES, the grid (placement and every
@@ -685,11 +706,11 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
     a time a step lands on (within 1e-9 relative, the end time always) is that step's state, so the steps
     and the solution do not depend on ``output.every``. With ``mesh.max_cells_across`` set, the grid is
     merged 3x3 each time the footprint spans more cells than that along x or z (snapshots then carry the
-    coarser frame). Returns a summary: time, steps, newton_iterations, retries, rejected (steps redone for a
-    too-long front advance), coarsenings, dx, dz (final cell sizes), cells, the sub-grid front (radius,
-    radius_min, radius_max, up, down, left, right), the footprint (area, area_radius, length, height;
-    geometry.py), w_inlet, p_inlet, the final balance (injected, stored, leaked) and max_balance_error
-    (relative).
+    coarser frame). Returns a summary: time, steps, newton_iterations, factorisations and gmres_iterations
+    (the linear solver's work, newton.NewtonWork), retries, rejected (steps redone for a too-long front
+    advance), coarsenings, dx, dz (final cell sizes), cells, the sub-grid front (radius, radius_min,
+    radius_max, up, down, left, right), the footprint (area, area_radius, length, height; geometry.py),
+    w_inlet, p_inlet, the final balance (injected, stored, leaked) and max_balance_error (relative).
 
     Checkpoints (hfgpu.io.checkpoint): after the first step that ends at or past each interval (and after
     that step's snapshots), ``checkpoint.save(t, state)`` gets {"engine": _Engine.state(), "dt": next step,
@@ -735,7 +756,8 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
                 checkpoint.save(eng.t, {"engine": eng.state(), "dt": dt, "target": index})
     final = eng.balance()
     return dict(time=eng.t, t0=eng.t0, steps=eng.steps, newton_iterations=eng.newton_iterations,
-                retries=eng.retries, rejected=eng.rejected, coarsenings=eng.coarsenings, dx=eng.dx, dz=eng.dz,
+                factorisations=eng.factorisations, gmres_iterations=eng.gmres_iterations, retries=eng.retries,
+                rejected=eng.rejected, coarsenings=eng.coarsenings, dx=eng.dx, dz=eng.dz,
                 cells=int(eng.grid["active"].sum()), w_inlet=final.inlet_width,
                 p_inlet=final.injection_pressure, injected=final.injected, stored=final.stored,
                 leaked=final.leaked, max_balance_error=eng.max_balance_error, **eng.front(eng.now()),
