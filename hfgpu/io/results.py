@@ -12,11 +12,13 @@ Layout (docs/results-format.md is the full contract; extend, never rename)::
     /closure                attrs dx, dz, x0, z0, time and the closure scalars; propped_width, conductivity, ...
     /checkpoint             attrs time and record counts; state/...: the simulator's state (removed when complete)
 
-Integrity: the file is open only while a snapshot is written, and every change is made on a copy that is
-renamed over the file when complete (``_edit``: HDF5 is not crash-safe on its own). A snapshot is built under
-a temporary name (``_incomplete``) and moved to its final zero-padded name once complete; balance records are buffered and written with each snapshot (and at close). A run killed at
-any moment therefore leaves every completed snapshot readable; a leftover ``_incomplete`` group is
-ignored by the reader. ``status`` is "running" until :meth:`ResultsWriter.close` writes "complete",
+Integrity: the file is open only while a snapshot is written, and every change is made on another copy
+that is renamed over the file when complete (HDF5 is not crash-safe on its own): a spare copy one write
+behind the file, which takes the write it lacks and the new one, so a write costs the write twice, not a copy
+of the file (``_TwinFile``). A snapshot is built under a temporary name (``_incomplete``) and moved to its
+final zero-padded name once complete; balance records are buffered and written with each snapshot (and at
+close). A run killed at any moment therefore leaves every completed snapshot readable; a leftover
+``_incomplete`` group is ignored by the reader. ``status`` is "running" until :meth:`ResultsWriter.close` writes "complete",
 "interrupted" or "failed: <message>"; a file still saying "running" after its run ended was killed.
 
 Checkpoints (:meth:`ResultsWriter.write_checkpoint`, :mod:`hfgpu.io.checkpoint`) are built under
@@ -29,6 +31,7 @@ reuses the old one's space instead of growing the file.
 from __future__ import annotations
 
 import contextlib
+import copy
 import functools
 import os
 import shutil
@@ -39,6 +42,11 @@ from typing import Any, Callable
 
 import h5py
 import numpy as np
+
+try:
+    import fcntl
+except ImportError:  # not POSIX
+    fcntl = None  # type: ignore[assignment]
 
 from ..errors import HfgpuError
 from .checkpoint import read_tree, write_tree
@@ -107,6 +115,87 @@ def _open(path: Path, mode: str) -> h5py.File:
     return h5py.File(path, mode, locking=False)
 
 
+SPARE = ".writing"       # suffix of the spare copy beside the results file
+PREVIOUS = ".previous"   # suffix of the replaced version while it becomes the spare
+
+
+class _TwinFile:
+    """The results file and a spare copy kept one write behind it (``<name>.writing``).
+
+    ``apply(write)``: ``write`` (a function of the open h5py.File) is applied to the spare after the write the
+    spare lacks, the spare is flushed to disk and renamed over the file, and the version it replaces, kept by
+    a hard link, becomes the next spare. The file at ``path`` is thus at every moment a complete version, and
+    a write costs the write twice instead of a copy of the whole file (copies would make a run's output time
+    grow with the square of its snapshot count). The spare is copied afresh from the file when there
+    is none, when hard links fail, or when a reader may still hold the replaced version open: on Linux a write
+    lease on it is refused then; elsewhere it is always copied. So a reader's open file never changes under
+    it. Writes are replayed, so they hold copies of their data, never the caller's arrays."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.spare = path.with_name(path.name + SPARE)
+        self._behind: Callable[[h5py.File], None] | None = None   # the write the spare lacks
+
+    def apply(self, write: Callable[[h5py.File], None]) -> None:
+        writes = [self._behind, write] if self._behind is not None and _unshared(self.spare) else None
+        self._behind = None
+        if writes is None:   # a new file: the old spare may be a reader's open version
+            self.spare.unlink(missing_ok=True)
+            shutil.copyfile(self.path, self.spare)
+            writes = [write]
+        try:
+            with _open(self.spare, "a") as f:
+                for change in writes:
+                    change(f)
+            with open(self.spare, "rb+") as raw:
+                os.fsync(raw.fileno())
+        except BaseException:
+            self.spare.unlink(missing_ok=True)
+            raise
+        previous = self.path.with_name(self.path.name + PREVIOUS)
+        kept = _hard_link(self.path, previous)
+        os.replace(self.spare, self.path)
+        if kept:
+            os.replace(previous, self.spare)
+            self._behind = write
+
+    def finish(self) -> None:
+        """Remove the spare (the run's last write is done)."""
+        self._behind = None
+        for path in (self.spare, self.path.with_name(self.path.name + PREVIOUS)):
+            path.unlink(missing_ok=True)
+
+
+def _hard_link(path: Path, link: Path) -> bool:
+    """Whether ``link`` is now a second name of ``path`` (False where the file system has no hard links)."""
+    try:
+        link.unlink(missing_ok=True)
+        os.link(path, link)
+    except OSError:
+        return False
+    return True
+
+
+def _unshared(path: Path) -> bool:
+    """Whether no open file refers to ``path`` (Linux: a write lease can be taken only then); False where this
+    cannot be told."""
+    setlease = getattr(fcntl, "F_SETLEASE", None)
+    if setlease is None:
+        return False
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return False
+    try:
+        fcntl.fcntl(fd, setlease, fcntl.F_WRLCK)
+        fcntl.fcntl(fd, setlease, fcntl.F_UNLCK)
+        return True
+    except OSError:
+        return False
+    finally:
+        os.close(fd)
+
+
 class ResultsWriter:
     """Output sink writing an HDF5 results file (the sink methods of hfgpu/records.py).
 
@@ -133,6 +222,7 @@ class ResultsWriter:
         self._pending: dict[str, list[tuple[float, ...]]] = {"fracture": [], "proppant": []}
         self._last_time = last_time
         self._closed = False
+        self._file = _TwinFile(path)
 
     @classmethod
     def reopen(cls, path: str | Path) -> tuple["ResultsWriter", float, dict]:
@@ -203,21 +293,26 @@ class ResultsWriter:
         """Replace ``/checkpoint`` with the simulator's ``state`` at simulated time ``time`` [s], after writing the
         buffered balance rows; records the snapshot and balance-row counts it belongs to (see the module
         docstring for the atomic swap)."""
-        with _edit(self.path) as f:
-            self._write_balance(f)
+        rows, state = self._take_rows(), copy.deepcopy(state)
+        counts = {f"{physics}_snapshots": n for physics, n in self._counts.items()}
+
+        def write(f: h5py.File) -> None:
+            _append_rows(f, rows)
             f.pop(NEW_CHECKPOINT, None)
             group = f.create_group(NEW_CHECKPOINT)
             write_tree(group.create_group("state"), state)
-            counts = {f"{physics}_snapshots": n for physics, n in self._counts.items()}
+            rows_now = {}
             for physics in self._counts:
-                rows = f.get(f"{physics}/balance/time")
-                counts[f"{physics}_balance_rows"] = rows.shape[0] if rows is not None else 0
-            group.attrs.update(time=float(time), **counts)
+                column = f.get(f"{physics}/balance/time")
+                rows_now[f"{physics}_balance_rows"] = column.shape[0] if column is not None else 0
+            group.attrs.update(time=float(time), **counts, **rows_now)
             group.attrs["complete"] = True
             f.flush()
             f.pop(CHECKPOINT, None)
             f.move(NEW_CHECKPOINT, CHECKPOINT)
             f.flush()
+
+        self._file.apply(write)
 
     # ending -----------------------------------------------------------------------------------
 
@@ -227,33 +322,44 @@ class ResultsWriter:
         if self._closed:
             return
         self._closed = True
-        with _edit(self.path) as f:
-            self._write_balance(f)
+        rows = self._take_rows()
+        values = {k: v for k, v in (summary or {}).items() if _is_scalar(v)}
+        values.update(status=status, sim_time=self._last_time, fracture_snapshots=self._counts["fracture"],
+                      proppant_snapshots=self._counts["proppant"])
+
+        def write(f: h5py.File) -> None:
+            _append_rows(f, rows)
             for physics in self._counts:
                 f.pop(f"{physics}/snapshots/{INCOMPLETE}", None)
             if status == "complete":
                 f.pop(CHECKPOINT, None)
                 f.pop(NEW_CHECKPOINT, None)
-            group = f.require_group("summary")
-            values = {k: v for k, v in (summary or {}).items() if _is_scalar(v)}
-            values.update(status=status, sim_time=self._last_time,
-                          fracture_snapshots=self._counts["fracture"],
-                          proppant_snapshots=self._counts["proppant"])
-            group.attrs.update(values)
+            f.require_group("summary").attrs.update(values)
             f.attrs["status"] = status
+
+        try:
+            self._file.apply(write)
+        finally:
+            self._file.finish()
 
     def write_closure(self, frame: GridFrame, fields: dict[str, np.ndarray], attrs: dict[str, Any]) -> None:
         """Replace ``/closure`` (grid ``fields`` on ``frame``, scalar ``attrs``) and add ``attrs`` prefixed
         ``closure_`` to ``/summary``, in one atomic edit (after :meth:`close`)."""
-        with _edit(self.path) as f:
+        arrays = {name: _array(array) for name, array in fields.items()}
+
+        def write(f: h5py.File) -> None:
             f.pop("closure", None)
             group = f.create_group("closure")
             group.attrs.update(dx=float(frame.dx), dz=float(frame.dz), x0=float(frame.x0), z0=float(frame.z0),
                                **attrs)
-            for name, array in fields.items():
-                _dataset(group, name, _array(array)).attrs["kind"] = "grid"
-            summary = f.require_group("summary")
-            summary.attrs.update({f"closure_{k}": v for k, v in attrs.items()})
+            for name, array in arrays.items():
+                _dataset(group, name, array).attrs["kind"] = "grid"
+            f.require_group("summary").attrs.update({f"closure_{k}": v for k, v in attrs.items()})
+
+        try:
+            self._file.apply(write)
+        finally:
+            self._file.finish()
 
     def fail(self, message: str, summary: dict[str, Any] | None = None) -> None:
         """Close with status "failed: <message>"."""
@@ -273,17 +379,22 @@ class ResultsWriter:
     def _snapshot(self, physics: str, time: float, frame: GridFrame,
                   data: dict[str, tuple[np.ndarray, str]], attrs: dict[str, Any]) -> None:
         self._last_time = max(self._last_time, float(time))
-        with _edit(self.path) as f:
-            self._write_balance(f)
+        rows, name = self._take_rows(), f"{self._counts[physics]:06d}"
+        arrays = {key: (_array(array), kind) for key, (array, kind) in data.items()}
+
+        def write(f: h5py.File) -> None:
+            _append_rows(f, rows)
             parent = f.require_group(f"{physics}/snapshots")
             parent.pop(INCOMPLETE, None)
             group = parent.create_group(INCOMPLETE)
             group.attrs.update(time=float(time), dx=float(frame.dx), dz=float(frame.dz),
                                x0=float(frame.x0), z0=float(frame.z0), **attrs)
-            for name, (array, kind) in data.items():
-                _dataset(group, name, _array(array)).attrs["kind"] = kind
-            parent.move(INCOMPLETE, f"{self._counts[physics]:06d}")
+            for key, (array, kind) in arrays.items():
+                _dataset(group, key, array).attrs["kind"] = kind
+            parent.move(INCOMPLETE, name)
             f.flush()
+
+        self._file.apply(write)
         self._counts[physics] += 1
 
     def _balance(self, physics: str, row: tuple[float, ...]) -> None:
@@ -291,29 +402,35 @@ class ResultsWriter:
         pending = self._pending[physics]
         pending.append(row)
         if len(pending) >= _BALANCE_FLUSH_ROWS:
-            with _edit(self.path) as f:
-                self._write_balance(f)
+            rows = self._take_rows()
+            self._file.apply(lambda f: _append_rows(f, rows))
 
-    def _write_balance(self, f: h5py.File) -> None:
-        for physics, names in (("fracture", FRACTURE_BALANCE), ("proppant", PROPPANT_BALANCE)):
-            rows = self._pending[physics]
-            if not rows:
-                continue
-            columns = np.array(rows, dtype=np.float64).T
-            group = f.require_group(f"{physics}/balance")
-            for name, column in zip(names, columns):
-                if name not in group:
-                    _dataset(group, name, np.zeros(0), maxshape=(None,), chunks=(1024,))
-                ds = group[name]
-                ds.resize((ds.shape[0] + column.size,))
-                ds[-column.size:] = column
-            rows.clear()
+    def _take_rows(self) -> dict[str, np.ndarray]:
+        """The buffered balance rows of each physics as (rows, columns) arrays, the buffers emptied."""
+        rows = {physics: np.array(pending, dtype=np.float64) for physics, pending in self._pending.items() if pending}
+        for pending in self._pending.values():
+            pending.clear()
+        return rows
+
+
+def _append_rows(f: h5py.File, rows: dict[str, np.ndarray]) -> None:
+    """Append balance rows ({physics: (rows, columns) array}) to ``/<physics>/balance``."""
+    for physics, names in (("fracture", FRACTURE_BALANCE), ("proppant", PROPPANT_BALANCE)):
+        if physics not in rows:
+            continue
+        group = f.require_group(f"{physics}/balance")
+        for name, column in zip(names, rows[physics].T):
+            if name not in group:
+                _dataset(group, name, np.zeros(0), maxshape=(None,), chunks=(1024,))
+            ds = group[name]
+            ds.resize((ds.shape[0] + column.size,))
+            ds[-column.size:] = column
 
 
 def _array(value: Any) -> np.ndarray:
-    """float64 for real data; integer labels (state, class_id) keep their type."""
+    """A copy: float64 for real data; integer labels (state, class_id) keep their type."""
     array = np.asarray(value)
-    return array.astype(np.float64) if array.dtype.kind == "f" else array
+    return array.astype(np.float64) if array.dtype.kind == "f" else array.copy()
 
 
 def _dataset(group: h5py.Group, name: str, data: np.ndarray, **options: Any) -> h5py.Dataset:

@@ -99,6 +99,61 @@ def test_not_a_results_file(tmp_path):
         open_results(tmp_path / "absent.h5")
 
 
+def _copies(monkeypatch) -> list:
+    """Record every whole-file copy the writer makes."""
+    import hfgpu.io.results as results
+
+    copies = []
+    real = results.shutil.copyfile
+    monkeypatch.setattr(results.shutil, "copyfile", lambda a, b: copies.append(a) or real(a, b))
+    return copies
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"),
+                    reason="the spare is reused only where a write lease tells that no reader holds it (Linux)")
+def test_writes_do_not_copy_the_file_and_spare_readers_are_safe(tmp_path, monkeypatch):
+    """Snapshot after snapshot the writer copies the file once (its spare), not once per write; the spare is
+    gone at close. A reader holding the file open across writes makes the writer copy afresh, and what the
+    reader holds does not change under it."""
+    copies = _copies(monkeypatch)
+    path = tmp_path / "r.h5"
+    w = ResultsWriter(path, load_scene(FRACTURE_SCENE))
+    for k in range(20):
+        w.fracture_balance(BalanceRecord(time=k + 1.0, injected=1.0, stored=1.0, leaked=0.0))
+        w.fracture_snapshot(fracture_snapshot(k + 1.0))
+    assert len(copies) == 1 and (tmp_path / "r.h5.writing").exists()
+    with h5py.File(path, "r", locking=False) as held:   # a reader opens version 20 and keeps it open
+        w.fracture_snapshot(fracture_snapshot(21.0))    # on the spare (19, free); 20 becomes the spare
+        w.fracture_snapshot(fracture_snapshot(22.0))    # 20 is held: a fresh copy of 21 takes 22
+        assert sorted(held["fracture/snapshots"]) == [f"{k:06d}" for k in range(20)]
+        np.testing.assert_array_equal(held["fracture/snapshots/000019/width"][()], fracture_snapshot(20.0).width)
+    assert len(copies) == 2
+    w.close()
+    assert not (tmp_path / "r.h5.writing").exists() and not (tmp_path / "r.h5.previous").exists()
+    r = open_results(path)
+    np.testing.assert_array_equal(r.fracture_snapshots.times, np.arange(1.0, 23.0))
+    np.testing.assert_array_equal(r.fracture_balance["time"], np.arange(1.0, 21.0))
+
+
+def test_replayed_writes_hold_their_own_data(tmp_path):
+    """A write is replayed on the spare at the next write: what it stores is the data of the moment it was
+    made, even if the caller changes its arrays afterwards (checkpoint state, snapshot fields)."""
+    path = tmp_path / "r.h5"
+    w = ResultsWriter(path, load_scene(FRACTURE_SCENE))
+    state = {"engine": {"w": np.arange(5.0), "t": 1.0}}
+    snap = fracture_snapshot(1.0)
+    w.write_checkpoint(1.0, state)
+    w.fracture_snapshot(snap)
+    state["engine"]["w"][:] = -1.0
+    snap.width[:] = -1.0
+    for t in (2.0, 3.0):   # each replays the previous write on the spare, which then becomes the file
+        w.fracture_snapshot(fracture_snapshot(t))
+    with h5py.File(path, "r") as f:
+        np.testing.assert_array_equal(f["checkpoint/state/engine/w"][()], np.arange(5.0))
+        np.testing.assert_array_equal(f["fracture/snapshots/000000/width"][()], fracture_snapshot(1.0).width)
+    w.close()
+
+
 WRITER = textwrap.dedent("""
     import dataclasses, sys
     from io_fakes import FRACTURE_SCENE, fracture_snapshot
