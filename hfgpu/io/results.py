@@ -129,14 +129,16 @@ class _TwinFile:
     grow with the square of its snapshot count). The spare is copied afresh from the file when there
     is none, when hard links fail, or when a reader may still hold the replaced version open: on Linux a write
     lease on it is refused then; elsewhere it is always copied. So a reader's open file never changes under
-    it. Writes are replayed, so they hold copies of their data, never the caller's arrays."""
+    it. Writes are replayed, so they hold copies of their data, never the caller's arrays; a write may give a
+    cheaper ``catch_up`` for the spare (a snapshot copies its group from the file, HDF5's object copy, instead
+    of building it again)."""
 
     def __init__(self, path: Path):
         self.path = path
         self.spare = path.with_name(path.name + SPARE)
         self._behind: Callable[[h5py.File], None] | None = None   # the write the spare lacks
 
-    def apply(self, write: Callable[[h5py.File], None]) -> None:
+    def apply(self, write: Callable[[h5py.File], None], catch_up: Callable[[h5py.File], None] | None = None) -> None:
         writes = [self._behind, write] if self._behind is not None and _unshared(self.spare) else None
         self._behind = None
         if writes is None:   # a new file: the old spare may be a reader's open version
@@ -157,7 +159,7 @@ class _TwinFile:
         os.replace(self.spare, self.path)
         if kept:
             os.replace(previous, self.spare)
-            self._behind = write
+            self._behind = catch_up or write
 
     def finish(self) -> None:
         """Remove the spare (the run's last write is done)."""
@@ -394,7 +396,12 @@ class ResultsWriter:
             parent.move(INCOMPLETE, name)
             f.flush()
 
-        self._file.apply(write)
+        def catch_up(f: h5py.File) -> None:
+            _append_rows(f, rows)
+            with _open(self.path, "r") as done:   # the file that holds this snapshot
+                done.copy(done[f"{physics}/snapshots/{name}"], f.require_group(f"{physics}/snapshots"), name)
+
+        self._file.apply(write, catch_up)
         self._counts[physics] += 1
 
     def _balance(self, physics: str, row: tuple[float, ...]) -> None:
