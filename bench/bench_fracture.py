@@ -61,7 +61,7 @@ def main() -> None:
     parser.add_argument("--every", default="1e4", help="output spacings [s] of the long run (same results)")
     args = parser.parse_args()
     print(f"{'case':6} {'front':>7} {'tip':>9} {'cap':>4} {'every':>6} {'cell [m]':>9} {'end cell':>9} {'cells':>6} {'steps':>6} {'newton':>7} "
-          f"{'retries':>7} {'rejected':>8} {'wall [s]':>9} {'R err':>8} {'Rmin err':>9} {'Rmax err':>9} "
+          f"{'factor.':>7} {'gmres':>6} {'retries':>7} {'rejected':>8} {'wall [s]':>9} {'R err':>8} {'Rmin err':>9} {'Rmax err':>9} "
           f"{'R(area)':>8} {'w0 err':>8} {'max|R(area)|':>12} {'max|w0|':>8}")
     for name in args.cases.split(","):
         base = load_scene(SCENES / f"radial_{name}.toml")
@@ -78,7 +78,7 @@ def main() -> None:
             out, wall, ref_r, w_err, r_max, w_max = run(scene)
             print(f"{name:6} {scene.fracture.front_tracking:>7} {scene.fracture.tip_asymptote:>9} {scene.mesh.max_cells_across or '-':>4} "
                   f"{scene.output.every:6.3g} {scene.mesh.dx:9.3g} {out['dx']:9.3g} {out['cells']:6d} {out['steps']:6d} "
-                  f"{out['newton_iterations']:7d} {out['retries']:7d} {out['rejected']:8d} {wall:9.2f} "
+                  f"{out['newton_iterations']:7d} {out['factorisations']:7d} {out['gmres_iterations']:6d} {out['retries']:7d} {out['rejected']:8d} {wall:9.2f} "
                   f"{out['radius'] / ref_r - 1:+8.2%} {out['radius_min'] / ref_r - 1:+9.2%} "
                   f"{out['radius_max'] / ref_r - 1:+9.2%} {out['area_radius'] / ref_r - 1:+8.2%} {w_err:+8.2%} "
                   f"{r_max:12.2%} {w_max:8.2%}", flush=True)

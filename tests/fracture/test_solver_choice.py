@@ -80,3 +80,15 @@ def test_auto_choice_is_deterministic():
     assert a == b
     forced = simulate(sc.replace(fracture=dataclasses.replace(sc.fracture, linear_solver="direct")), MemorySink())
     assert forced["cells"] == a["cells"]
+
+
+def test_summary_counts_the_linear_solvers_work():
+    """The run summary adds up each step's NewtonWork: the dense path factorises and runs no GMRES; the Krylov
+    path runs GMRES with fewer factorisations (preconditioners) than Newton iterations."""
+    sc = scene(end_time="30 s", cell="1 m")
+    runs = {solver: simulate(sc.replace(fracture=dataclasses.replace(sc.fracture, linear_solver=solver)),
+                             MemorySink()) for solver in ("direct", "krylov")}
+    direct, krylov = runs["direct"], runs["krylov"]
+    assert direct["gmres_iterations"] == 0 and 0 < direct["factorisations"] <= direct["newton_iterations"]
+    assert krylov["gmres_iterations"] >= krylov["newton_iterations"] > 0
+    assert 0 < krylov["factorisations"] < krylov["newton_iterations"]
