@@ -4,6 +4,11 @@ closed) end a run as Ctrl-C does. The run's ``KeyboardInterrupt`` path then clos
 
 Handlers are installed only in the main thread (Python delivers signals there); elsewhere, e.g. inside a Dask
 worker's thread, the context manager changes nothing.
+
+A handler's exception is lost when the signal lands while Python runs a finalizer or a weakref callback (it
+prints "Exception ignored in ..." and goes on). The handler therefore also records the signal, and the block's
+:class:`StopSignal` raises it again at the caller's next safe point (``check``, called after every step), so a
+stop signal always ends the run.
 """
 
 from __future__ import annotations
@@ -30,20 +35,34 @@ def signal_number(exc: KeyboardInterrupt) -> int:
     return exc.signal_number if isinstance(exc, Interrupted) else int(signal.SIGINT)
 
 
+class StopSignal:
+    """The stop signal received inside a :func:`stop_signals_interrupt` block, if any (``number``)."""
+
+    def __init__(self):
+        self.number: int | None = None
+
+    def check(self) -> None:
+        """Raise :class:`Interrupted` for a stop signal whose own raise was lost (module docstring)."""
+        if self.number is not None:
+            raise Interrupted(self.number)
+
+
 @contextmanager
-def stop_signals_interrupt() -> Iterator[None]:
-    """Within the block, SIGTERM and SIGHUP raise :class:`Interrupted` in the main thread; the previous
-    handlers are restored on leaving it."""
+def stop_signals_interrupt() -> Iterator[StopSignal]:
+    """Within the block, SIGTERM and SIGHUP raise :class:`Interrupted` in the main thread (and are recorded in
+    the :class:`StopSignal` it yields); the previous handlers are restored on leaving it."""
+    stop = StopSignal()
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield stop
         return
 
     def handler(number: int, frame: object) -> None:
+        stop.number = number
         raise Interrupted(number)
 
     previous = {number: signal.signal(number, handler) for number in STOP_SIGNALS}
     try:
-        yield
+        yield stop
     finally:
         for number, old in previous.items():
             signal.signal(number, old)

@@ -139,8 +139,9 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
         _carry_over(bar, kept)
     sinks.append(bar)
     try:
-        with stop_signals_interrupt(), blas_threads(), bar.holding_warnings():  # printed after the bar
-            result = simulate(scene, FanOut(sinks), progress=bar, checkpoint=checkpoint, resume=state)
+        with stop_signals_interrupt() as stop, blas_threads(), bar.holding_warnings():  # printed after the bar
+            result = simulate(scene, FanOut(sinks), progress=_checked(bar, stop), checkpoint=checkpoint,
+                              resume=state)
     except KeyboardInterrupt as exc:
         _close_others(sinks[1:])
         writer.close("interrupted", {**bar.stats(), "interrupted_by": signal.Signals(signal_number(exc)).name})
@@ -161,6 +162,17 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
             print(schedule_table(scene, scene.output.units), flush=True)
         print(summary_table(summary, scene.output.units, scene), flush=True)
     return summary
+
+
+def _checked(bar: Any, stop: Any) -> Callable[[float], None]:
+    """The progress callback, first raising a stop signal whose own raise was lost (hfgpu.interrupts): the
+    engines call it after every step. Keeps the bar's ``phase`` (the coupled run's second bar)."""
+    def progress(t: float) -> None:
+        stop.check()
+        bar(t)
+
+    progress.phase = bar.phase  # type: ignore[attr-defined]
+    return progress
 
 
 def _write_closure(writer: Any, scene: Scene) -> dict[str, Any]:
