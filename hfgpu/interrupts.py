@@ -1,6 +1,7 @@
 """Stop signals during a run: SIGTERM (``kill``, batch schedulers at their time limit) and SIGHUP (the terminal
-closed) end a run as Ctrl-C does. The run's ``KeyboardInterrupt`` path then closes the results file with status
-"interrupted", its summary and its checkpoint kept, so that ``hfgpu run --resume`` continues it.
+closed) end a run as Ctrl-C (SIGINT) does. The run's ``KeyboardInterrupt`` path then closes the results file
+with status "interrupted", its summary and its checkpoint kept, so that ``hfgpu run --resume`` continues it. A
+signal the process ignores stays ignored (``nohup`` ignores SIGHUP, a shell's background job SIGINT).
 
 Handlers are installed only in the main thread (Python delivers signals there); elsewhere, e.g. inside a Dask
 worker's thread, the context manager changes nothing.
@@ -18,8 +19,8 @@ import threading
 from contextlib import contextmanager
 from typing import Iterator
 
-#: Signals handled as Ctrl-C (SIGHUP does not exist on Windows).
-STOP_SIGNALS = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name))
+#: Signals that stop a run (SIGHUP does not exist on Windows).
+STOP_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
 
 
 class Interrupted(KeyboardInterrupt):
@@ -49,8 +50,9 @@ class StopSignal:
 
 @contextmanager
 def stop_signals_interrupt() -> Iterator[StopSignal]:
-    """Within the block, SIGTERM and SIGHUP raise :class:`Interrupted` in the main thread (and are recorded in
-    the :class:`StopSignal` it yields); the previous handlers are restored on leaving it."""
+    """Within the block, SIGINT, SIGTERM and SIGHUP raise :class:`Interrupted` in the main thread (and are
+    recorded in the :class:`StopSignal` it yields), except those the process ignores; the previous handlers
+    are restored on leaving it."""
     stop = StopSignal()
     if threading.current_thread() is not threading.main_thread():
         yield stop
@@ -60,7 +62,8 @@ def stop_signals_interrupt() -> Iterator[StopSignal]:
         stop.number = number
         raise Interrupted(number)
 
-    previous = {number: signal.signal(number, handler) for number in STOP_SIGNALS}
+    previous = {number: signal.signal(number, handler) for number in STOP_SIGNALS
+                if signal.getsignal(number) is not signal.SIG_IGN}
     try:
         yield stop
     finally:

@@ -55,3 +55,23 @@ def _spin() -> None:
     """Run bytecode so the pending signal's handler runs here, inside the callback."""
     for _ in range(1000):
         pass
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGHUP"), reason="no SIGHUP")
+def test_an_ignored_signal_stays_ignored_and_ctrl_c_is_recorded():
+    """Under nohup (SIGHUP ignored) closing the terminal does not stop the run; Ctrl-C raises Interrupted with
+    SIGINT, recorded like the others."""
+    before = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    try:
+        with pytest.raises(Interrupted) as caught:
+            with stop_signals_interrupt() as stop:
+                assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+                os.kill(os.getpid(), signal.SIGHUP)
+                _spin()
+                stop.check()   # nothing received
+                os.kill(os.getpid(), signal.SIGINT)
+                _spin()
+        assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGHUP, before)
+    assert signal_number(caught.value) == signal.SIGINT and stop.number == signal.SIGINT
