@@ -62,6 +62,7 @@ def test_an_ignored_signal_stays_ignored_and_ctrl_c_is_recorded():
     """Under nohup (SIGHUP ignored) closing the terminal does not stop the run; Ctrl-C raises Interrupted with
     SIGINT, recorded like the others."""
     before = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    before_int = signal.signal(signal.SIGINT, signal.default_int_handler)   # as from a terminal
     try:
         with pytest.raises(Interrupted) as caught:
             with stop_signals_interrupt() as stop:
@@ -74,4 +75,5 @@ def test_an_ignored_signal_stays_ignored_and_ctrl_c_is_recorded():
         assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
     finally:
         signal.signal(signal.SIGHUP, before)
+        signal.signal(signal.SIGINT, before_int)
     assert signal_number(caught.value) == signal.SIGINT and stop.number == signal.SIGINT

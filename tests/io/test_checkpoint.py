@@ -225,7 +225,8 @@ def _signalled_once_checkpointed(tmp_path: Path, path: Path, number: int) -> tup
     scene = tmp_path / "scene.toml"
     scene.write_text(FRACTURE.replace('checkpoint_every = "7 s"', 'checkpoint_every = "3 s"'))
     command = [sys.executable, "-m", "hfgpu.cli", "run", str(scene), "--out", str(path), "--no-progress"]
-    proc = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_default_stop_signals)
     deadline = time.monotonic() + 120.0
     try:
         while proc.poll() is None and time.monotonic() < deadline:
@@ -239,6 +240,14 @@ def _signalled_once_checkpointed(tmp_path: Path, path: Path, number: int) -> tup
         proc.send_signal(number)
         _, stderr = proc.communicate(timeout=60)
     return command, proc.returncode, stderr
+
+
+def _default_stop_signals() -> None:
+    """The run starts with its stop signals at their defaults, as from a terminal: under nohup or as a
+    background job the test run would pass SIGHUP or SIGINT on ignored, and hfgpu leaves an ignored signal
+    ignored."""
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        signal.signal(getattr(signal, name), signal.SIG_DFL)
 
 
 def test_killed_cli_run_keeps_its_snapshots_and_resumes(reference, tmp_path):
