@@ -58,7 +58,8 @@ class BalanceRecord:
     of the solver), and the pressure history a treatment is read by: the fluid pressure in the injection cell
     [Pa], the net pressure there (that pressure minus the minimum stress at the injection depth) [Pa], the
     fluid efficiency stored / injected, the footprint's area [m^2], length and height [m] (geometry.py), the
-    width of the injection cell [m]. The history fields are NaN where a record does not carry them (a results file written before they existed)."""
+    width of the injection cell [m]. The history fields are NaN where a record does not carry them (a results
+    file written before they existed)."""
 
     time: float
     injected: float

@@ -98,11 +98,12 @@ def sweep(sweep_file: str | Path, out: str | Path, *, workers: int | None = None
         writer.write(values)
     pending = [m for m in todo if m.id not in rows]
     try:
-        with stop_signals_interrupt():  # SIGTERM, SIGHUP: as Ctrl-C, the cluster closed on the way out
+        with stop_signals_interrupt() as stop:  # SIGTERM, SIGHUP: as Ctrl-C, the cluster closed on the way out
             if pending:
                 for values in _run_members(pending, folder, names, len(todo), workers, scheduler, progress):
                     rows[values["id"]] = values
                     writer.write(values)
+                    stop.check()   # a stop signal whose raise was lost (hfgpu.interrupts)
     finally:
         writer.close()
     ordered = [rows[m.id] for m in todo]

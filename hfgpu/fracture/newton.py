@@ -89,17 +89,11 @@ class StepProblem:
 
 @dataclass
 class NewtonWork:
-    """Work of Newton solves: iterations that solved for an update, factorisations (dense LU or the Krylov
-    preconditioner's SuperLU) and GMRES iterations."""
+    """Linear-algebra work of Newton solves (StepResult.iterations counts the iterations): factorisations
+    (dense LU or the Krylov preconditioner's SuperLU) and GMRES iterations."""
 
-    iterations: int = 0
     factorisations: int = 0
     gmres_iterations: int = 0
-
-    def add(self, other: "NewtonWork") -> None:
-        self.iterations += other.iterations
-        self.factorisations += other.factorisations
-        self.gmres_iterations += other.gmres_iterations
 
 
 @dataclass(frozen=True)
@@ -272,7 +266,6 @@ def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nd
                     inverse = precond.matvec
         except (np.linalg.LinAlgError, ValueError, scipy.linalg.LinAlgWarning):
             return x, False, it
-        work.iterations += 1
         if not np.all(np.isfinite(dx)):
             return x, False, it
         scale = np.linalg.norm(dx) if dense else np.linalg.norm(inverse(-r.f))

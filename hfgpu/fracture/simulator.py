@@ -255,7 +255,7 @@ class _Engine:
             return self._step_subgrid(dt, keep_ends)
         g = self.grid
         start = g.copy() if keep_ends else None
-        reach_old = self._front_reach(self.distances_now())
+        reach_old = self._front_reach(self._view_distances(self.now()))
         h = min(self.dx, self.dz)
         for attempt in range(self.num.max_step_retries + 1):
             res = self._solve(dt)
@@ -466,16 +466,6 @@ class _Engine:
         self._properties()
         self._rebuild()
 
-    def distances_now(self) -> list[np.ndarray]:
-        """front.front_distances of the current state (per side, from each edge cell's centre to the front),
-        computed once per state: the balance's area, the front summary and the next step's front reach share
-        them (any change of the widths or of the active set clears them)."""
-        if self.distances is None:
-            g = self.grid
-            self.distances = front_distances(self.tip, g["active"], g["w"], g["p"], self.kprime_box,
-                                             self.cprime_box, g["reached"], self.t, self.dx, self.dz)
-        return self.distances
-
     def _front_reach(self, distances: list[np.ndarray]) -> np.ndarray:
         """Largest sub-grid front distance s (Eq. 33 inverted, front.front_distances) of every box cell,
         capped at 2 cells; 0 where a cell faces no inactive cell."""
@@ -601,12 +591,18 @@ class _Engine:
             extras={k: np.array(v) for k, v in scalars.items()})
 
     def _view_distances(self, view: _View) -> list[np.ndarray]:
-        """front.front_distances of ``view``: the shared ones (``distances_now``) when it is the current state."""
-        if view.grid is self.grid and view.t == self.t:
-            return self.distances_now()
+        """front.front_distances of ``view`` (per side, from each edge cell's centre to the front). The current
+        state's are computed once and kept in ``distances``: the balance's area, the front summary and the next
+        step's front reach share them (a change of the widths or of the active set clears them)."""
+        now = view.grid is self.grid and view.t == self.t
+        if now and self.distances is not None:
+            return self.distances
         g = view.grid
-        return front_distances(self.tip, g["active"], g["w"], g["p"], view.kprime_box, view.cprime_box,
-                               g["reached"], view.t, g.dx, g.dz)
+        distances = front_distances(self.tip, g["active"], g["w"], g["p"], view.kprime_box, view.cprime_box,
+                                    g["reached"], view.t, g.dx, g.dz)
+        if now:
+            self.distances = distances
+        return distances
 
     def geometry(self, view: _View) -> dict:
         """Area, equal-area radius, length and height of the footprint, tip cells by their filled fraction
