@@ -21,8 +21,11 @@ mechanism controls early growth -- and the cells' opening times follow that vert
 their opening times (at most 90 % of it), in the shape a uniform net pressure gives (C w = const).
 
 Coarsening. With ``mesh.max_cells_across`` set, the grid is merged 3x3 (coarsen.py; odd so the source
-stays cell-centred) each time the footprint spans more cells than that along x or z; volume is carried
-exactly, so the balance holds across the merge, and the active-cell count stays bounded.
+stays cell-centred) after a step whose footprint spans more cells than that along x or z; volume is
+carried exactly, so the balance holds across the merge, and the active-cell count stays bounded. The merge
+comes after the step's records and snapshots (``coarsen_if_wide``, called by ``simulate`` before it sets the
+next step), so they are of the fine grid's state: a merged state is only the next step's start, its 3x3
+means of widths and tip cells not a solution.
 
 Partially filled tip cells (``partial_tip_cells``). A newly opened cell records, besides its opening time,
 the time the front will have crossed it (its parent's crossing time, Eq. 34); its Carter leak-off is the
@@ -360,7 +363,6 @@ class _Engine:
             dt *= 0.5
         self._accept(res, dt, advance, start if keep_ends else None)
         self.v_front, self.t_front = self.v_tip, self.t
-        self._coarsen_if_wide()
         return dt
 
     def _front_iterations(self, dt: float, start) -> tuple:
@@ -500,9 +502,8 @@ class _Engine:
         if g.shape != before:
             self._properties()
         self._rebuild()
-        self._coarsen_if_wide()
 
-    def _coarsen_if_wide(self) -> None:
+    def coarsen_if_wide(self) -> None:
         """Continue on a 3x3 coarser grid (coarsen.py) once the footprint spans more than
         ``mesh.max_cells_across`` cells along x or z. Fluid volume is carried exactly (w = sum of the
         children's w / 9), pressure as the mean, opening and front-arrival times as the earliest child's."""
@@ -747,6 +748,8 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
                 view = eng.now() if _landed(outputs[k], eng.t) else eng.between(outputs[k])
                 sink.fracture_snapshot(eng.snapshot(view, outputs[k]))
                 k += 1
+            if eng.t < targets[-1]:   # a merge is for the steps that follow
+                eng.coarsen_if_wide()
             dt = eng.next_dt(dt if taken == step else taken)
             if checkpoint is not None and checkpoint.due(eng.t):
                 checkpoint.save(eng.t, {"engine": eng.state(), "dt": dt, "target": index})

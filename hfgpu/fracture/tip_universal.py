@@ -23,7 +23,9 @@ their numerical solution in between.
 
 ``width`` (w for given s) and ``distance`` (s for given w) solve the relation for one unknown per cell with
 a vectorised bracketed root find (Illinois regula falsi on the logarithm of the unknown): at fixed s the
-residual s^ - g is decreasing in w, at fixed w increasing in s, and the vertex widths bound the root.
+residual s^ - g is decreasing in w, at fixed w increasing in s, and the vertex widths bound the root. Where
+K' = C' = 0 (a pure-viscosity scene) the relation is the M vertex itself, delta = 1/3 and 3 C1(1/3) =
+beta_m^3, and both are its closed form (no root to find).
 """
 
 from __future__ import annotations
@@ -146,6 +148,9 @@ def width(s, e_prime, k_prime, c_prime, mu_prime, v) -> np.ndarray:
     s, k_prime, c_prime, v = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (s, k_prime, c_prime, v)))
     w = k_prime / e_prime * np.sqrt(s)
     moving = (v > 0.0) & (s > 0.0)
+    m_edge = moving & (k_prime == 0.0) & (c_prime == 0.0)
+    w[m_edge] = m_scale(e_prime, mu_prime, v[m_edge]) * s[m_edge] ** (2.0 / 3.0)
+    moving &= ~m_edge
     if moving.any():
         args = (e_prime, k_prime[moving], c_prime[moving], mu_prime, v[moving])
         sm = s[moving]
@@ -162,6 +167,9 @@ def distance(w, e_prime, k_prime, c_prime, mu_prime, v) -> np.ndarray:
         s = np.where(k_prime > 0.0, (e_prime * w / np.where(k_prime > 0.0, k_prime, 1.0)) ** 2, np.inf)
     s[w == 0.0] = 0.0
     moving = (v > 0.0) & (w > 0.0)
+    m_edge = moving & (k_prime == 0.0) & (c_prime == 0.0)
+    s[m_edge] = (w[m_edge] / m_scale(e_prime, mu_prime, v[m_edge])) ** 1.5
+    moving &= ~m_edge
     if moving.any():
         args = (e_prime, k_prime[moving], c_prime[moving], mu_prime, v[moving])
         wm = w[moving]

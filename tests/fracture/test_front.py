@@ -35,6 +35,15 @@ def test_m_vertex():
     assert w == pytest.approx(m_width(S, V), rel=1e-9)
 
 
+def test_m_edge_closed_form_is_the_root_of_the_general_relation():
+    """K' = C' = 0 takes the M vertex's closed form; the root find at a vanishing K' lands on it (1e-9)."""
+    tiny = 1e-30
+    w = tu.width(S, E_PRIME, tiny, 0.0, MU_PRIME, V)
+    assert tu.width(S, E_PRIME, 0.0, 0.0, MU_PRIME, V) == pytest.approx(w, rel=1e-9)
+    assert tu.distance(w, E_PRIME, 0.0, 0.0, MU_PRIME, V) == pytest.approx(
+        tu.distance(w, E_PRIME, tiny, 0.0, MU_PRIME, V), rel=1e-9)
+
+
 def test_k_vertex_at_rest_and_for_a_slow_tip():
     k = 2e6
     assert tu.width(S, E_PRIME, k, 1e-4, MU_PRIME, 0.0) == pytest.approx(k / E_PRIME * np.sqrt(S), rel=1e-12)
