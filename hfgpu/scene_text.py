@@ -6,8 +6,8 @@
 A key is a dotted path with ``[i]`` for an entry of an array of tables (``rock.layers[0].min_stress``), as a
 sweep's ``key``; it holds one value or an array of values (``run.physics``, ``mesh.cell_size``), never a table
 or an array of tables. A value is what the scene file would hold there ("2.5 m", 0.2, true,
-["fracture", "proppant"]); None removes the key, so that the scene's default applies (TOML has no null), and
-removing a key the scene does not hold is an error. The scene's TOML text (``Scene.source``) is parsed, the
+["fracture", "proppant"]); None removes the key, so that the scene's default applies (TOML has no null: None
+inside an array is an error), and removing a key the scene does not hold is an error. The scene's TOML text (``Scene.source``) is parsed, the
 keys set or removed in order, written back (:func:`toml_text`: comments dropped, values as parsed) and read
 again with :func:`hfgpu.load_scene`, so errors name the key as for a scene file.
 ``Scene.replace`` changes parsed values only: the text it keeps no longer describes the scene
@@ -44,6 +44,9 @@ def edit_scene(scene: Any, changes: dict[str, Any]) -> Any:
 
     data = tomllib.loads(scene.source)
     for key, value in changes.items():
+        if value is not None and _holds_none(value):
+            raise SceneError(key, value, "None inside a value: TOML has no null; None as the whole value "
+                             "removes the key")
         steps = split_key(key, key, data, arrays=True)
         data = _without(data, steps, key) if value is None else with_value(data, steps, value)
     said = ", ".join(f"{k} removed" if v is None else f"{k} = {_value(v)}" for k, v in changes.items())
@@ -91,6 +94,17 @@ def split_key(key: str, where: str, scene_data: dict, error: type[SceneError] = 
         allowed = "one value or an array of values" if arrays else "one value"
         raise error(where, key, f"expected a key holding {allowed}, not {kind}")
     return tuple(steps)
+
+
+def _holds_none(value: Any) -> bool:
+    """Whether None is anywhere in a value (an entry of an array, a value of a table)."""
+    if value is None:
+        return True
+    if isinstance(value, dict):
+        return any(_holds_none(v) for v in value.values())
+    if isinstance(value, (list, tuple)):
+        return any(_holds_none(v) for v in value)
+    return False
 
 
 def _kind(node: Any) -> str:

@@ -97,6 +97,13 @@ def test_removing_a_key_the_scene_does_not_hold_names_it(key):
                                "be removed")
 
 
+def test_none_inside_a_value_is_refused_naming_the_key():
+    with pytest.raises(SceneError) as info:
+        edit_scene(load_scene(FIELD), {"run.physics": ["fracture", None]})
+    assert info.value.path == "run.physics"
+    assert "TOML has no null" in str(info.value)
+
+
 def test_run_warns_when_the_scene_no_longer_matches_its_text():
     scene = load_scene(FIELD)
     with warnings.catch_warnings():
