@@ -43,7 +43,7 @@ def test_volume_balance_holds_across_coarsening_and_footprint_stays_capped():
 def test_long_storage_viscosity_radial_case_with_coarsening():
     """radial_long.toml: 0.1 m cells to 1e5 s (R ~ 270 m), five 3x3 merges at 24 cells across, universal tip
     asymptote; radius from the area, front radius and inlet width vs Dontsov (2016). Measured: R from the
-    area -0.54 %, front -0.22 %, w(0) -0.06 %, 129 steps, ~4 s (issue 19's goal at the end: 1 %)."""
+    area -0.54 %, front -0.22 %, w(0) -0.06 %, 129 steps, ~2 s (issue 19's goal at the end: 1 %)."""
     sc = load_scene(SCENES / "radial_long.toml")
     out = simulate(sc, MemorySink())
     rock, q, end = sc.rock, sc.injection.schedule.stages[0].rate, sc.run.end_time
