@@ -161,6 +161,13 @@ class _TwinFile:
             os.replace(previous, self.spare)
             self._behind = catch_up or write
 
+    def apply_last(self, write: Callable[[h5py.File], None]) -> None:
+        """``apply(write)`` as the file's last write, then ``finish`` (also when the write fails)."""
+        try:
+            self.apply(write)
+        finally:
+            self.finish()
+
     def finish(self) -> None:
         """Remove the spare (the run's last write is done)."""
         self._behind = None
@@ -339,10 +346,7 @@ class ResultsWriter:
             f.require_group("summary").attrs.update(values)
             f.attrs["status"] = status
 
-        try:
-            self._file.apply(write)
-        finally:
-            self._file.finish()
+        self._file.apply_last(write)
 
     def write_closure(self, frame: GridFrame, fields: dict[str, np.ndarray], attrs: dict[str, Any]) -> None:
         """Replace ``/closure`` (grid ``fields`` on ``frame``, scalar ``attrs``) and add ``attrs`` prefixed
@@ -358,10 +362,7 @@ class ResultsWriter:
                 _dataset(group, name, array).attrs["kind"] = "grid"
             f.require_group("summary").attrs.update({f"closure_{k}": v for k, v in attrs.items()})
 
-        try:
-            self._file.apply(write)
-        finally:
-            self._file.finish()
+        self._file.apply_last(write)
 
     def fail(self, message: str, summary: dict[str, Any] | None = None) -> None:
         """Close with status "failed: <message>"."""
