@@ -14,7 +14,9 @@ Cases:
 * radial: ``examples/radial_viscosity_explicit.py`` (41 x 41 cells on 0.6 m, remeshed by compressing the domain,
   R 0.1 m to 1e5 s, explicit front, M tip asymptote: the example's K_Ic = 0.5 MPa m^0.5 does not enter, so the
   fracture it computes is the pure-viscosity one) against ``hfgpu/scenes/radial_viscosity.toml`` (the same
-  injection with K_Ic = 0). Closed form: the M vertex (Savitski & Detournay 2002, mu' = 12 mu). Errors of the
+  injection with K_Ic = 0; whole cells opening, 3x3 merges at 36 cells across) and
+  ``radial_viscosity_subgrid.toml`` (PyFrac's kind of front and remeshing: the sub-grid front, the grid
+  coarsened by 2 at 40 cells across). Closed form: the M vertex (Savitski & Detournay 2002, mu' = 12 mu). Errors of the
   radius from the footprint's area, R_A = sqrt(A / pi), and of the inlet width w(0).
 * height: ``examples/Ex2_height_contained_CPC.py`` (6 m layer at 1 MPa between 7.5 MPa barriers, K_Ic 0, 125 x 35
   cells on [-20, 20] x [-2.3, 2.3] m, compressed (domain and cells doubled) when the front reaches its edge, to
@@ -34,7 +36,8 @@ from its log ("number of time steps"), cells = cells of the final footprint (cha
 With --pyfrac-results DIR each PyFrac run's results go to DIR/<case>-<threads>.json (its working directory,
 log and saved fractures under DIR/<case>-<threads>/) and are read from there on the next call instead of
 rerunning PyFrac (--rerun-pyfrac forces a run); without --pyfrac the PyFrac rows come from DIR alone. hfgpu
-always runs; its log and record (with the series) go to DIR/hfgpu-<case>-<threads>.log/.json.
+always runs, once per scene of the case (the "scene" column); its log and record (with the series) go to
+DIR/hfgpu-<scene>-<threads>.log/.json. The PyFrac/hfgpu wall ratio is against the case's first scene.
 
 Usage: python bench/bench_pyfrac.py [--pyfrac /path/to/PyFrac] [--pyfrac-python /path/to/python]
        [--pyfrac-results DIR] [--rerun-pyfrac | --pyfrac-no-run] [--cases radial,height] [--threads default,one]
@@ -75,13 +78,14 @@ RADIAL_FROM_FACTOR = 10.0  # radial case: errors over the run from 10x the run's
 class Case:
     example: str        # PyFrac's examples/<example>
     data: str           # its output folder, relative to the working directory
-    scene: str          # hfgpu's scene in hfgpu/scenes
+    scenes: tuple       # hfgpu's scenes in hfgpu/scenes (the first: the wall ratio's)
     size: str           # the size the errors are of
 
 
 CASES = {
-    "radial": Case("radial_viscosity_explicit.py", "Data/M_radial_explicit", "radial_viscosity.toml", "R_A"),
-    "height": Case("Ex2_height_contained_CPC.py", "Data/height_contained", "pyfrac_height_contained.toml", "l"),
+    "radial": Case("radial_viscosity_explicit.py", "Data/M_radial_explicit",
+                   ("radial_viscosity.toml", "radial_viscosity_subgrid.toml"), "R_A"),
+    "height": Case("Ex2_height_contained_CPC.py", "Data/height_contained", ("pyfrac_height_contained.toml",), "l"),
 }
 
 
@@ -260,15 +264,15 @@ def run_pyfrac(case: str, threads: str, checkout: Path, python: str, results: Pa
     return record
 
 
-def hfgpu_worker(case: str) -> None:
-    """In the timed subprocess: run hfgpu's scene of ``case``, print its record as JSON."""
+def hfgpu_worker(scene: str) -> None:
+    """In the timed subprocess: run hfgpu's ``scene`` (in hfgpu/scenes), print its record as JSON."""
     from hfgpu.fracture.simulator import simulate
     from hfgpu.records import MemorySink
     from hfgpu.scene import load_scene
 
     sink = MemorySink()
     start = time.perf_counter()
-    out = simulate(load_scene(SCENES / CASES[case].scene), sink)
+    out = simulate(load_scene(SCENES / scene), sink)
     wall = time.perf_counter() - start
     keep = ("steps", "newton_iterations", "retries", "rejected", "coarsenings", "cells", "dx", "dz", "area",
             "area_radius", "length", "height", "w_inlet", "time")
@@ -280,18 +284,18 @@ def hfgpu_worker(case: str) -> None:
                    "w0": [r.inlet_width for r in rec]}}))
 
 
-def run_hfgpu(case: str, threads: str, logs: Path) -> dict:
-    log = logs / f"hfgpu-{case}-{threads}.log"
+def run_hfgpu(case: str, scene: str, threads: str, logs: Path) -> dict:
+    log = logs / f"hfgpu-{Path(scene).stem}-{threads}.log"
     env = thread_env(threads)
     env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH", "")) if p)
-    wall, cpu, rc = timed([sys.executable, str(Path(__file__).resolve()), "--hfgpu-worker", case], ROOT, env, log)
+    wall, cpu, rc = timed([sys.executable, str(Path(__file__).resolve()), "--hfgpu-worker", scene], ROOT, env, log)
     text = log.read_text(errors="replace")
     line = next((ln for ln in text.splitlines() if ln.startswith("JSON")), None)
     if rc != 0 or line is None:
-        raise SystemExit(f"hfgpu's {case} run failed (exit {rc}):\n{text[-3000:]}")
+        raise SystemExit(f"hfgpu's {scene} run failed (exit {rc}):\n{text[-3000:]}")
     data = json.loads(line[4:])
     s = data["summary"]
-    record = {"code": "hfgpu", "case": case, "threads": threads, "wall_s": wall, "cpu_s": cpu,
+    record = {"code": "hfgpu", "case": case, "scene": Path(scene).stem, "threads": threads, "wall_s": wall, "cpu_s": cpu,
               "steps": s["steps"], "newton_iterations": s.get("newton_iterations"), "cells": s["cells"],
               "mesh": {"dx": s.get("dx"), "dz": s.get("dz")}, "summary": s, "series": data["series"]}
     log.with_suffix(".json").write_text(json.dumps(record))   # for a look at the series; never read back
@@ -308,7 +312,7 @@ def size_series(case: str, record: dict) -> dict:
 
 
 HEADER = (f"{'case':7} {'code':7} {'threads':8} {'wall s':>8} {'CPU s':>8} {'steps':>6} {'cells':>6} {'size':>4} "
-          f"{'end err':>8} {'max err':>8} {'w0 end':>8} {'w0 max':>8} {'from s':>7} {'PyFrac/hfgpu wall':>17}")
+          f"{'end err':>8} {'max err':>8} {'w0 end':>8} {'w0 max':>8} {'from s':>7} {'PyFrac/hfgpu wall':>17}  scene")
 
 
 def common_from(case: str, records: list[dict]) -> float | None:
@@ -325,7 +329,8 @@ def row(case: str, record: dict, hfgpu_wall: float | None, t_from: float | None 
              else f"{'':17}")
     return (f"{case:7} {record['code']:7} {record['threads']:8} {record['wall_s']:8.1f} {record['cpu_s']:8.1f} "
             f"{record['steps']:6d} {record['cells']:6d} {CASES[case].size:>4} {e['size_end']:+8.2%} "
-            f"{e['size_max']:+8.2%} {e['w0_end']:+8.2%} {e['w0_max']:+8.2%} {e['from']:7.3g} {ratio}")
+            f"{e['size_max']:+8.2%} {e['w0_end']:+8.2%} {e['w0_max']:+8.2%} {e['from']:7.3g} {ratio}  "
+            f"{record.get('scene', '')}")
 
 
 def mesh_note(case: str, record: dict) -> str:
@@ -336,7 +341,7 @@ def mesh_note(case: str, record: dict) -> str:
                 f"y {m['y'][0]:.4g}..{m['y'][1]:.4g} m; {record['remeshings']} remeshings, "
                 f"{record['failed_steps']} failed steps, {record['saved']} saved fractures")
     m = record["mesh"]
-    return (f"{case} hfgpu {record['threads']}: final cells {m['dx']:.4g} x {m['dz']:.4g} m, "
+    return (f"{case} hfgpu {record['scene']} {record['threads']}: final cells {m['dx']:.4g} x {m['dz']:.4g} m, "
             f"{record['newton_iterations']} Newton iterations")
 
 
@@ -373,18 +378,18 @@ def main() -> None:
     for case in cases:
         pairs = []
         for threads in threads_list:
-            ours = None if args.no_hfgpu else run_hfgpu(case, threads, logs)
+            ours = [] if args.no_hfgpu else [run_hfgpu(case, scene, threads, logs) for scene in CASES[case].scenes]
             theirs = (run_pyfrac(case, threads, args.pyfrac, args.pyfrac_python, results, args.rerun_pyfrac,
                                  not args.pyfrac_no_run) if results is not None else None)
             pairs.append((ours, theirs))
-            for record in (ours, theirs):
+            for record in [*ours, theirs]:
                 if record is not None:
                     print(row(case, record, None), file=sys.stderr, flush=True)
-        t_from = common_from(case, [r for pair in pairs for r in pair if r is not None])
+        t_from = common_from(case, [r for ours, theirs in pairs for r in [*ours, theirs] if r is not None])
         for ours, theirs in pairs:
-            for record in (ours, theirs):
+            for record in [*ours, theirs]:
                 if record is not None:
-                    rows.append(row(case, record, ours["wall_s"] if ours else None, t_from))
+                    rows.append(row(case, record, ours[0]["wall_s"] if ours else None, t_from))
                     notes.append(mesh_note(case, record))
     print(HEADER)
     print("\n".join(rows))

@@ -201,13 +201,15 @@ class Mesh:
     """The cell sizes in use [m]: ``dx``, ``dz`` = the scene's ``[mesh] cell_size`` / ``refinement``.
 
     ``max_cells_across`` (in use, i.e. the scene's value x refinement, at least 8) caps the footprint's cells
-    along x or z (the fracture grid is coarsened 3x3 beyond it, see docs/scene.md), None for no cap.
+    along x or z (the fracture grid is coarsened beyond it, by ``coarsening_factor``: 3, merging 3 x 3, or 2,
+    PyFrac's remeshing; see docs/scene.md), None for no cap.
     """
 
     dx: float
     dz: float
     max_cells_across: int | None = None
     refinement: float = 1.0
+    coarsening_factor: int = 3
 
     @property
     def scene_cell_size(self) -> tuple[float, float]:
@@ -434,9 +436,10 @@ def _parse_mesh(t: Table, preset: Preset) -> Mesh:
     cap = t.raw("max_cells_across", None)
     if cap is not None:
         cap = max(8, round(t.integer("max_cells_across", minimum=8) * refinement))
+    factor = t.integer("coarsening_factor", 3, minimum=2, maximum=3)
     t.finish()
     return Mesh(dx=sizes[0] / refinement, dz=sizes[1] / refinement, max_cells_across=cap,
-                refinement=refinement)
+                refinement=refinement, coarsening_factor=factor)
 
 
 #: Snapshots a run writes when ``[output] every`` is not given: every = end_time / DEFAULT_SNAPSHOTS.

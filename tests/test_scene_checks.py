@@ -239,7 +239,7 @@ def test_all_errors_of_a_scene_in_one_report(tmp_path, capsys):
     assert out == "" and err.splitlines() == [
         "hfgpu check: error: scene key 'fluid.viscosity': got '-1 cP'; allowed: > 0 Pa*s",
         "hfgpu check: error: scene key 'mesh.cells': got 3; unknown key; did you mean 'cell_size'? keys allowed "
-        "here: cell_size, max_cells_across, refinement",
+        "here: cell_size, coarsening_factor, max_cells_across, refinement",
         "hfgpu check: error: scene key 'rock.poisson_ratio': got 0.7; allowed: >= 0 and < 0.5",
         "hfgpu check: error: scene key 'rock.layers[2].bottom': got '10000 ft'; a layer's bottom must lie below its "
         "top ('10040 ft'); depth is positive downward"]

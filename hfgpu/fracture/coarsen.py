@@ -1,28 +1,38 @@
-"""Coarsening of the fracture grid: merge factor x factor cells (3 x 3 by default) into one.
+"""Coarsening of the fracture grid: continue on cells ``factor`` times larger (3 x 3 merges by default, or 2x).
 
-When the fracture outgrows the cell budget the engine continues on a grid ``factor`` times coarser. The
-merge works on the integer-index representation of the active cells and keeps the injection (source) cell
-at the centre of its coarse cell, so the point source of Eq. 29 stays a cell-centred source:
+When the fracture outgrows the cell budget the engine continues on a grid ``factor`` times coarser, its
+cells centred on the injection (source) cell, so the point source of Eq. 29 stays a cell-centred source.
+The map works on the integer-index representation of the active cells as (child, parent, share) triples:
+fine cell ``child`` covers the part ``share`` of its area in coarse cell ``parent``.
 
-* the merge factor is odd (3 by default); a 2 x 2 merge cannot keep the source centred (its coarse centre
-  falls on a fine-grid vertex), a 3 x 3 merge does so trivially;
-* blocks are aligned on the source cell ``(cx, cz)``: coarse cell ``(K, L)`` holds the fine cells
-  ``cx + f K - h .. cx + f K + h`` by ``cz + f L - h .. cz + f L + h`` (h = (f - 1) / 2), so it is centred
-  on fine cell ``(cx + f K, cz + f L)`` and the source's coarse index is ``(0, 0)``; with the source at fine
-  index (0, 0) both grids share their origin and coarse centres lie at ``(K f dx, L f dz)``;
-* a coarse cell is active when any of its children is (no fluid is dropped).
+* Odd factor f (3 by default): blocks are aligned on the source cell ``(cx, cz)``: coarse cell ``(K, L)``
+  holds the fine cells ``cx + f K - h .. cx + f K + h`` by ``cz + f L - h .. cz + f L + h`` (h = (f - 1) / 2),
+  whole (share 1), so it is centred on fine cell ``(cx + f K, cz + f L)`` and the source's coarse index is
+  ``(0, 0)``.
+* f = 2: coarse cell ``(K, L)`` spans fine offsets ``2K - 1 .. 2K + 1`` from the source along x (and the
+  same along z): the fine cell at an even offset lies inside it, one at an odd offset is cut in half between
+  two coarse cells (share 1/2 per axis, 1/4 at a corner). The coarse cells do not nest the fine ones, but they
+  stay centred on the source (PyFrac's remeshing by 2); the fields are carried by area overlap.
 
-Per-cell fields are carried by stated rules (``Coarsening`` methods):
+A coarse cell is active when any active fine cell overlaps it (no fluid is dropped). Per-cell fields are
+carried by stated rules (``Coarsening`` methods):
 
-* ``width(w)``: w_coarse = (sum of the children's widths) / f^2, inactive children counting as zero
-  opening, so the fluid volume sum w dA is unchanged (to round-off);
-* ``total(q)``: sum over children, for extensive per-cell quantities (volumes, masses);
-* ``mean(p)``: area-weighted mean over the active children (pressure; all children have equal area);
-* ``earliest(t)``: minimum over the active children (opening time tau of the Carter leak-off term of
-  Eq. 29 and activation times of Eq. 34);
-* ``fill``: number of active children / f^2 per coarse cell (1 inside, < 1 at the front).
+* ``width(w)``: w_coarse = sum(share x w) / f^2, inactive fine cells counting as zero opening, so the fluid
+  volume sum w dA is unchanged (to round-off);
+* ``total(q)``: sum of share x q, for extensive per-cell quantities (volumes, masses);
+* ``mean(p)``: area-weighted mean over the overlapping active fine cells (pressure);
+* ``earliest(t)``: minimum over the overlapping active fine cells (opening time tau of the Carter leak-off term
+  of Eq. 29 and activation times of Eq. 34);
+* ``fill``: the part of the coarse cell the active fine cells cover (1 inside, < 1 at the front).
 
-Public API: ``coarsen(ix, iz, source=(0, 0), factor=3) -> Coarsening``.
+The sub-grid front crosses the merge too (``coarse_front``): a coarse cell's wetted fraction is the
+area-weighted mean of its fine cells' (inactive ones 0), so the wetted area sum f dA is carried exactly; a
+coarse cell not wholly wetted is a tip cell, its front normal the share-weighted sum of its fine tip cells'
+normals (where it has none, minus the sum of its fine cells' offsets from its centre weighted by their wetted
+areas: the direction of its dry part), and its advance the one whose plane front wets that fraction
+(tip_cells.advance_for_fill).
+
+Public API: ``coarsen(ix, iz, source=(0, 0), factor=3) -> Coarsening``, ``coarse_front``.
 """
 
 from __future__ import annotations
@@ -31,48 +41,64 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .tip_cells import advance_for_fill
+
 
 @dataclass(frozen=True)
 class Coarsening:
-    """Fine-to-coarse map: coarse active cells (ix, iz), and for each fine cell the index of its parent."""
+    """Fine-to-coarse map: coarse active cells (ix, iz) and the (child, parent, share) triples of the overlap
+    (module docstring; with an odd factor ``child`` is every fine cell once, in order, and ``share`` 1)."""
 
     factor: int
     ix: np.ndarray
     iz: np.ndarray
+    child: np.ndarray
     parent: np.ndarray
+    share: np.ndarray
     fill: np.ndarray
 
     def total(self, values: np.ndarray) -> np.ndarray:
-        """Sum over each coarse cell's active children (extensive quantities)."""
-        return np.bincount(self.parent, weights=self._checked(values), minlength=self.ix.size)
+        """Sum of share x value over each coarse cell's overlapping active fine cells (extensive quantities)."""
+        return np.bincount(self.parent, weights=self.share * self._checked(values)[self.child],
+                           minlength=self.ix.size)
 
     def width(self, w: np.ndarray) -> np.ndarray:
-        """Coarse opening conserving fluid volume: sum(children w) dA / (f^2 dA) (inactive children: 0)."""
+        """Coarse opening conserving fluid volume: sum(share w) dA / (f^2 dA) (inactive fine cells: 0)."""
         return self.total(w) / self.factor**2
 
     def mean(self, values: np.ndarray) -> np.ndarray:
-        """Area-weighted (equal areas: arithmetic) mean over each coarse cell's active children (pressure)."""
+        """Area-weighted mean over each coarse cell's overlapping active fine cells (pressure)."""
         return self.total(values) / (self.fill * self.factor**2)
 
     def earliest(self, times: np.ndarray) -> np.ndarray:
-        """Minimum over each coarse cell's active children (opening and activation times)."""
+        """Minimum over each coarse cell's overlapping active fine cells (opening and activation times)."""
         out = np.full(self.ix.size, np.inf)
-        np.minimum.at(out, self.parent, self._checked(times))
+        np.minimum.at(out, self.parent, self._checked(times)[self.child])
         return out
 
     def _checked(self, values: np.ndarray) -> np.ndarray:
         values = np.asarray(values, dtype=float)
-        if values.shape != self.parent.shape:
-            raise ValueError(f"Coarsening: a per-cell field must have shape {self.parent.shape} (one value "
-                             f"per fine active cell); got {values.shape}")
+        fine = int(self.child.max()) + 1
+        if values.shape != (fine,):
+            raise ValueError(f"Coarsening: a per-cell field must have shape ({fine},) (one value per fine active "
+                             f"cell); got {values.shape}")
         return values
 
 
-def coarsen(ix: np.ndarray, iz: np.ndarray, source: tuple[int, int] = (0, 0), factor: int = 3) -> Coarsening:
-    """Merge factor x factor blocks of fine cells, blocks aligned so the source cell is a coarse centre.
+def _axis(offset: np.ndarray, factor: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(coarse index, share) pairs of fine cells at integer ``offset`` from the source along one axis."""
+    if factor % 2:
+        return [(np.floor_divide(offset + (factor - 1) // 2, factor), np.ones(offset.size))]
+    odd = offset % 2 == 1
+    half = np.where(odd, 0.5, 1.0)
+    return [(np.floor_divide(offset, 2), half), (np.floor_divide(offset + 1, 2), np.where(odd, 0.5, 0.0))]
 
-    ``ix``, ``iz``: fine active-cell indices (distinct cells); ``source``: the injection cell's fine index.
-    Coarse index K = floor((ix - cx + h) / f), h = (f - 1) / 2 (module docstring).
+
+def coarsen(ix: np.ndarray, iz: np.ndarray, source: tuple[int, int] = (0, 0), factor: int = 3) -> Coarsening:
+    """The map onto cells ``factor`` times larger centred on the source cell (module docstring).
+
+    ``ix``, ``iz``: fine active-cell indices (distinct cells); ``source``: the injection cell's fine index;
+    ``factor``: 2 or an odd integer >= 3.
     """
     ix = np.asarray(ix)
     iz = np.asarray(iz)
@@ -81,19 +107,50 @@ def coarsen(ix: np.ndarray, iz: np.ndarray, source: tuple[int, int] = (0, 0), fa
                          f"{ix.shape} and {iz.shape}")
     if not (np.issubdtype(ix.dtype, np.integer) and np.issubdtype(iz.dtype, np.integer)):
         raise ValueError(f"coarsen: ix and iz must be integer arrays; got {ix.dtype} and {iz.dtype}")
-    if not (isinstance(factor, (int, np.integer)) and factor >= 3 and factor % 2 == 1):
-        raise ValueError(f"coarsen: factor = {factor!r}; must be an odd integer >= 3 (an even merge cannot "
-                         "keep the source cell at a coarse cell centre)")
+    if not (isinstance(factor, (int, np.integer)) and (factor == 2 or (factor >= 3 and factor % 2 == 1))):
+        raise ValueError(f"coarsen: factor = {factor!r}; must be 2 or an odd integer >= 3 (the coarse cells "
+                         "must stay centred on the source cell)")
     cx, cz = (int(v) for v in source)
-    half = (factor - 1) // 2
-    big_k = np.floor_divide(ix.astype(np.int64) - cx + half, factor)
-    big_l = np.floor_divide(iz.astype(np.int64) - cz + half, factor)
     fine_key = (iz.astype(np.int64) - iz.min()) * (int(ix.max() - ix.min()) + 1) + (ix - ix.min())
     if np.unique(fine_key).size != ix.size:
         raise ValueError("coarsen: the active cells (ix, iz) contain repeated cells")
+    cells = np.arange(ix.size)
+    triples = [(cells, big_k, big_l, share_x * share_z)
+               for big_k, share_x in _axis(ix.astype(np.int64) - cx, factor)
+               for big_l, share_z in _axis(iz.astype(np.int64) - cz, factor)]
+    child, big_k, big_l, share = (np.concatenate(parts) for parts in zip(*triples))
+    keep = share > 0.0
+    child, big_k, big_l, share = child[keep], big_k[keep], big_l[keep], share[keep]
     span = int(big_k.max() - big_k.min()) + 1
     key = (big_l - big_l.min()) * span + (big_k - big_k.min())
     unique_key, first, parent = np.unique(key, return_index=True, return_inverse=True)
-    children = np.bincount(parent, minlength=unique_key.size)
-    return Coarsening(factor=int(factor), ix=big_k[first], iz=big_l[first], parent=parent.ravel(),
-                      fill=children / factor**2)
+    covered = np.bincount(parent.ravel(), weights=share, minlength=unique_key.size)
+    return Coarsening(factor=int(factor), ix=big_k[first], iz=big_l[first], child=child, parent=parent.ravel(),
+                      share=share, fill=covered / factor**2)
+
+
+def coarse_front(c: Coarsening, ix: np.ndarray, iz: np.ndarray, fill: np.ndarray, nx: np.ndarray,
+                 nz: np.ndarray, dx: float, dz: float) -> tuple[np.ndarray, np.ndarray]:
+    """(fill, advance) of the coarse cells of ``c`` from the sub-grid front on the fine grid (module
+    docstring): ``ix``, ``iz`` the fine active cells given to ``coarsen`` (source at (0, 0)), ``fill`` their
+    wetted fractions, ``nx``, ``nz`` the front's unit normal at the fine tip cells (0 elsewhere), dx, dz the
+    fine cell. advance is NaN at the wholly wetted (channel) coarse cells."""
+    f = c.factor
+    wet = np.clip(fill, 0.0, 1.0)
+    fill_c = c.total(wet) / f**2
+    gx, gz = c.total(nx), c.total(nz)
+    # the share-weighted offsets of a coarse cell's fine cells sum to zero over the whole cell, so the sum of
+    # (1 - fill) x offset is minus that of fill x offset over the active ones
+    ox = -np.bincount(c.parent, weights=c.share * wet[c.child] * (ix[c.child] - f * c.ix[c.parent]) * dx,
+                      minlength=c.ix.size)
+    oz = -np.bincount(c.parent, weights=c.share * wet[c.child] * (iz[c.child] - f * c.iz[c.parent]) * dz,
+                      minlength=c.ix.size)
+    from_tips = np.hypot(gx, gz) > 0.0
+    vx, vz = np.where(from_tips, gx, ox), np.where(from_tips, gz, oz)
+    norm = np.hypot(vx, vz)
+    vx = np.where(norm > 0.0, vx / np.where(norm > 0.0, norm, 1.0), 1.0)
+    vz = np.where(norm > 0.0, vz / np.where(norm > 0.0, norm, 1.0), 0.0)
+    tip = fill_c < 1.0
+    advance = np.full(fill_c.shape, np.nan)
+    advance[tip] = advance_for_fill(fill_c[tip], vx[tip], vz[tip], f * dx, f * dz)
+    return np.where(tip, fill_c, 1.0), advance

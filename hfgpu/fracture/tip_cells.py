@@ -150,6 +150,20 @@ def wetted_fraction(advance: np.ndarray, nx: np.ndarray, nz: np.ndarray, dx: flo
     return np.where(y >= p + q, 1.0, np.where(y <= 0.0, 0.0, f))
 
 
+def advance_for_fill(fill: np.ndarray, nx: np.ndarray, nz: np.ndarray, dx: float, dz: float,
+                     iterations: int = 64) -> np.ndarray:
+    """The inverse of ``wetted_fraction``: the advance at which a cell with front normal n is wetted by
+    ``fill`` in (0, 1]. f rises monotonically from 0 at advance -(P + Q)/2 to 1 at +(P + Q)/2; bisection
+    on that bracket to round-off."""
+    p, q = _spread(nx, nz, dx, dz)
+    lo, hi = -0.5 * (p + q), 0.5 * (p + q)
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        short = wetted_fraction(mid, nx, nz, dx, dz) < fill
+        lo, hi = np.where(short, mid, lo), np.where(short, hi, mid)
+    return 0.5 * (lo + hi)
+
+
 def fill_and_width(model: TipModel, advance: np.ndarray, nx: np.ndarray, nz: np.ndarray, k_prime: np.ndarray,
                    c_prime: np.ndarray, v: np.ndarray, dx: float, dz: float) -> tuple[np.ndarray, np.ndarray]:
     """Wetted fraction (``wetted_fraction``) and mean width of cells crossed by the plane front

@@ -255,3 +255,17 @@ def test_subgrid_front_through_a_coarsening_with_snapshots_at_every_step():
     ref = dontsov_radial(rock.plane_strain_modulus, np.sqrt(32 / np.pi) * rock.toughness, 12 * sc.fluid.viscosity,
                          2 * rock.leakoff_coefficient, sc.injection.schedule.stages[0].rate, sc.run.end_time)
     assert out["radius"] == pytest.approx(ref.R[-1], rel=0.10)
+
+
+@pytest.mark.parametrize("angle", [0.0, 0.2, np.pi / 4, 1.3, 3.0])
+def test_advance_for_fill_inverts_the_wetted_fraction(angle):
+    """tip_cells.advance_for_fill is the inverse of wetted_fraction: the same advance back to 1e-9 of a
+    cell wherever the front crosses the cell (0 < f < 1, where the inverse is unique)."""
+    from hfgpu.fracture.tip_cells import advance_for_fill
+
+    dx, dz = 0.9, 1.6
+    n = (np.full(41, np.cos(angle)), np.full(41, np.sin(angle)))
+    reach = 0.5 * (abs(np.cos(angle)) * dx + abs(np.sin(angle)) * dz)
+    advance = np.linspace(-0.999, 0.999, 41) * reach
+    fill = wetted_fraction(advance, *n, dx, dz)
+    np.testing.assert_allclose(advance_for_fill(fill, *n, dx, dz), advance, rtol=0, atol=1e-9 * dx)
