@@ -28,7 +28,9 @@ GMRES path, keeps the preconditioner M for the next solve. A chord update that f
 is not taken; the Jacobian is rebuilt at the same iterate. On the height-contained example (0-6 s) this cut
 the LU factorisations from 5.2 to 2.1 a step (same widths to 1e-7); GMRES solves to rtol
 min(1e-3, GMRES_TOLERANCE_FACTOR eps), which left the Newton iterations unchanged and halved the GMRES
-iterations against 0.1 eps.
+iterations against 0.1 eps. A solve may start from the preconditioner of an earlier solve on the same cells
+(``solve_step(..., preconditioner)``: the sub-grid front's solves within a step), built anew where GMRES fails
+with it: radial case IV 26 -> 18 s, the same results to the digits bench_fracture prints.
 
 Contact. Widths cannot go negative (the faces would interpenetrate). After Newton converges, an open cell
 with w < 0 is closed: its width is held at 0 and its unknown becomes its fluid pressure (p = sigma + c0 x,
@@ -48,7 +50,7 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 from functools import partial
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.linalg
@@ -105,6 +107,7 @@ class StepResult:
     converged: bool
     residual: np.ndarray      # final Eq. 29 residual per cell [m^3]
     work: NewtonWork          # the step's linear-algebra work (all contact passes)
+    preconditioner: Any = None   # Newton-Krylov: the last preconditioner, for a next solve on the same cells
 
 
 class Elasticity:
@@ -228,9 +231,10 @@ def _krylov_update(prob, elastic, f, lap, cond, diag, rtol, closed, precond=None
 
 
 def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray, tolerance: float,
-            max_iterations: int, work: NewtonWork) -> tuple[np.ndarray, bool, int]:
-    """Damped Newton on Eq. 29 for a fixed contact set (module docstring); (x, converged, iterations), the
-    work done added to ``work``.
+            max_iterations: int, work: NewtonWork, precond=None) -> tuple[np.ndarray, bool, int, Any]:
+    """Damped Newton on Eq. 29 for a fixed contact set (module docstring); (x, converged, iterations, the
+    last Newton-Krylov preconditioner), the work done added to ``work``. ``precond``: a preconditioner of an
+    earlier solve on the same cells, tried first (a new one is built where GMRES fails with it).
 
     Jacobian reuse: the monotonicity test of an undamped update already gives the simplified Newton
     correction at the new iterate with the current factorisation, dx' = -J_k^-1 F(x + dx). When it contracts
@@ -241,7 +245,7 @@ def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nd
     r = residual(prob, elastic, x, closed)
     it = 0
     dense = elastic.matrix is not None
-    inverse = precond = chord = None   # the current factorisation (x -> J^-1 x or M x), the next chord step
+    inverse = chord = None   # the current factorisation (x -> J^-1 x or M x), the next chord step
     for it in range(1, max_iterations + 1):
         fresh = chord is None
         try:
@@ -265,9 +269,9 @@ def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nd
                     dx = _volume_exact(prob, r, dx, closed)
                     inverse = precond.matvec
         except (np.linalg.LinAlgError, ValueError, scipy.linalg.LinAlgWarning):
-            return x, False, it
+            return x, False, it, precond
         if not np.all(np.isfinite(dx)):
-            return x, False, it
+            return x, False, it, precond
         scale = np.linalg.norm(dx) if dense else np.linalg.norm(inverse(-r.f))
         step, accepted, simplified = 1.0, False, None
         for _ in range(MONOTONICITY_HALVINGS):
@@ -285,13 +289,13 @@ def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nd
         x = x + step * dx
         r = trial
         if np.linalg.norm(dx) < tolerance * max(np.linalg.norm(x), 1e-300):   # undamped update
-            return x, True, it
+            return x, True, it, precond
         reuse = (REUSE_JACOBIAN and accepted and step == 1.0
                  and np.linalg.norm(simplified) <= REUSE_CONTRACTION * scale)
         chord = _volume_exact(prob, r, simplified, closed) if reuse and dense else None
         if not reuse:
             precond = None
-    return x, False, it
+    return x, False, it, precond
 
 
 def _volume_exact(prob: StepProblem, r: Residual, dx: np.ndarray, closed: np.ndarray) -> np.ndarray:
@@ -336,12 +340,14 @@ def start_widths(prob: StepProblem) -> np.ndarray:
 
 
 def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_iterations: int,
-               w_start: np.ndarray | None = None, closed_start: np.ndarray | None = None) -> StepResult:
+               w_start: np.ndarray | None = None, closed_start: np.ndarray | None = None,
+               preconditioner: Any = None) -> StepResult:
     """Newton iterations on Eq. 29 until ||dw|| < tolerance ||w|| (Eq. 32), then the contact set is updated
     (cells with w < 0 closed, closed cells whose fluid pressure exceeds sigma + C w opened) and Newton rerun
     until it settles (at most CONTACT_PASSES times); never raises on failure. ``closed_start``: cells that
     start closed (the contact set of the previous step: with it, a step whose set does not change needs one
-    Newton pass instead of two)."""
+    Newton pass instead of two). ``preconditioner``: StepResult.preconditioner of an earlier solve on the
+    same active cells and contact set (Newton-Krylov: its SuperLU is tried first instead of a new one)."""
     x = (start_widths(prob) if w_start is None else w_start).astype(float, copy=True)
     pinned = np.zeros(x.size, bool) if prob.pinned is None else np.isfinite(prob.pinned)
     closed = pinned if closed_start is None else pinned | closed_start
@@ -350,7 +356,8 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
     iterations = 0
     work = NewtonWork()
     for _ in range(CONTACT_PASSES):
-        x, converged, it = _newton(prob, elastic, x, closed, tolerance, max_iterations, work)
+        x, converged, it, preconditioner = _newton(prob, elastic, x, closed, tolerance, max_iterations, work,
+                                                   preconditioner)
         iterations += it
         if not converged:
             break
@@ -361,7 +368,8 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
             break
         x = np.where(to_close, (p - prob.sigma) / elastic.self_stiffness, np.where(to_open, 0.0, x))
         closed = (closed | to_close) & ~to_open
+        preconditioner = None
     r = residual(prob, elastic, x, closed)
     ok = converged and bool(np.all(np.isfinite(r.f)))
     return StepResult(w=r.w, p=r.p, leaked=prob.area * prob.demand * r.g, iterations=iterations, converged=ok,
-                      residual=r.f, work=work)
+                      residual=r.f, work=work, preconditioner=preconditioner)

@@ -281,10 +281,12 @@ class _Engine:
         self._advance_front()
         return dt
 
-    def _solve(self, dt: float, pinned: np.ndarray | None = None, w_start: np.ndarray | None = None):
+    def _solve(self, dt: float, pinned: np.ndarray | None = None, w_start: np.ndarray | None = None,
+               preconditioner=None):
         """One implicit step [t, t + dt] from the grid's state (newton.solve_step) on the current active set;
         ``pinned``: prescribed widths (NaN: unknown) of the active cells, whose ``fill`` is their wetted
-        fraction (sub-grid front); ``w_start``: Newton's first iterate (None: newton.start_widths)."""
+        fraction (sub-grid front); ``w_start``: Newton's first iterate (None: newton.start_widths);
+        ``preconditioner``: an earlier solve's on the same active set (StepResult.preconditioner)."""
         g = self.grid
         sel = (self.rows, self.cols)
         w_old, tau, leaked_old = g["w"][sel], g["opened"][sel], g["leaked"][sel]
@@ -305,7 +307,7 @@ class _Engine:
         with blas_threads(self.ix.size):
             res = solve_step(prob, self.elastic, self.num.newton_tolerance, self.num.newton_max_iterations,
                              None if w_start is None else np.where(w_start > 0.0, w_start, start_widths(prob)),
-                             closed)
+                             closed, preconditioner)
         self.newton_iterations += res.iterations
         self.factorisations += res.work.factorisations
         self.gmres_iterations += res.work.gmres_iterations
@@ -397,8 +399,11 @@ class _Engine:
         last = None        # the last solved widths on the box: Newton's first iterate
         bracket = _Brackets(g.shape)
         s_start = np.where(channel, start["advance"], np.nan)   # the ribbons' distances at the start, if known
+        precond = None     # the last solve's Newton-Krylov preconditioner, while the active set stays
         for _ in range(FRONT_ITERATIONS):
-            res = self._solve(dt, pinned_box[self.rows, self.cols], None if last is None else last[self.rows, self.cols])
+            res = self._solve(dt, pinned_box[self.rows, self.cols], None if last is None else last[self.rows, self.cols],
+                              precond)
+            precond = res.preconditioner
             if not res.converged:
                 return res, advance, False
             w_box, p_box = g["w"].copy(), g["p"].copy()
@@ -428,6 +433,7 @@ class _Engine:
                 break   # far past the limit already: the step will be redone shorter
             if entered:
                 bracket = _Brackets(g.shape)
+                precond = None
         res = self._solve(dt, pinned_box[self.rows, self.cols])   # the last front, on the last active set
         return res, advance, res.converged
 

@@ -54,6 +54,18 @@ def test_direct_and_krylov_paths_agree():
     np.testing.assert_allclose(a.w, b.w, rtol=1e-5, atol=1e-9)
 
 
+def test_krylov_preconditioner_of_an_earlier_solve_is_reused():
+    """A second Newton-Krylov solve on the same cells given the first's preconditioner (the sub-grid front's
+    iterations within a step) builds none of its own while GMRES converges with it, and lands on the same
+    widths to the Newton tolerance."""
+    prob, el = _problem(dense=False, demand=1e-5)
+    first = solve_step(prob, el, 1e-9, 30)
+    again = solve_step(prob, el, 1e-9, 30, preconditioner=first.preconditioner)
+    assert first.converged and again.converged and first.preconditioner is not None
+    assert first.work.factorisations >= 1 and again.work.factorisations == 0
+    np.testing.assert_allclose(again.w, first.w, rtol=1e-7, atol=1e-12)
+
+
 def _leakoff_dominated_step(dense):
     """A long step of radial case IV's start (Table 2: E' 6.07 GPa, mu' 0.012 Pa s, 3.5 cm cells): the step's
     Carter demand is 4x the widths and the widths must triple. A line search on ||F|| stalled here (the cubic
