@@ -11,6 +11,7 @@ scene with errors prints only its errors.
 Warnings (the scene is valid, but likely not what was meant):
 
 * a preset coarsens the scene's cells (``[run] preset`` with refinement < 1 and no ``[mesh] refinement``);
+* ``[mesh] coarsening_factor`` 2 without ``max_cells_across`` (the grid is never coarsened);
 * the injection depth lies above or below every layer of ``[[rock.layers]]``;
 * ``run.end_time`` ends before the pump schedule (its last stages are not pumped) or after it (the rest is shut in;
   a last stage at rate 0 ending at end_time says so and silences the warning);
@@ -73,6 +74,9 @@ def review(scene: Scene) -> list[str]:
     system = scene.output.units
     found: list[str] = []
     found += _preset_coarsens(scene, system)
+    if scene.mesh.coarsening_factor != 3 and scene.mesh.max_cells_across is None:
+        found.append(f"mesh.coarsening_factor {scene.mesh.coarsening_factor} has no effect without "
+                     "mesh.max_cells_across: the grid is never coarsened")
     if scene.injection is not None:
         found += _schedule(scene, system)
     if scene.rock is not None and scene.rock.layers and scene.injection is not None and scene.has("fracture"):

@@ -117,6 +117,13 @@ def test_preset_that_coarsens_the_cells_warns_and_shows_the_cells_in_use(tmp_pat
     assert "cells 40 x 40 ft" in out and "40 x 40 ft = cell_size 20 x 20 ft / refinement 0.5" in out
 
 
+def test_coarsening_factor_without_a_cap_warns():
+    text = FIELD.replace('cell_size = "20 ft"', 'cell_size = "20 ft"\ncoarsening_factor = 2')
+    assert warnings_of(text) == [
+        "mesh.coarsening_factor 2 has no effect without mesh.max_cells_across: the grid is never coarsened"]
+    assert warnings_of(text.replace("coarsening_factor = 2", "coarsening_factor = 2\nmax_cells_across = 40")) == []
+
+
 def test_check_refuses_what_the_engine_refuses_after_the_preset(tmp_path, capsys):
     """The issue's case: check said ok, run refused fracture.initial_radius_cells after the preset doubled the cells."""
     path = tmp_path / "short.toml"
