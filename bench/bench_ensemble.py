@@ -3,7 +3,7 @@
 worker processes; prints the wall times, the parallel efficiency and the expected wall time of a 200-member
 study on N cores.
 
-    python bench/bench_ensemble.py [--members 16] [--workers 1 2] [--preset fast] [--base-case 94]
+    python bench/bench_ensemble.py [--members 16] [--workers 1 2] [--preset fast] [--base-case 64]
 
 Wall time counts everything ``hfgpu.sweep`` does: checking the members, starting and closing the local
 cluster (each worker process also compiles the Taichi kernels once, about 3 s), the runs, summary.csv and
@@ -41,8 +41,8 @@ def main() -> None:
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--preset", choices=("fast", "balanced", "accurate"), help="default: the scene's own")
     parser.add_argument("--out", type=Path, default=Path("bench_ensemble_output"))
-    parser.add_argument("--base-case", type=float, default=94.0, help="wall seconds of one run of the 3600 s "
-                        "base case (docs/field-case.md: 94 s)")
+    parser.add_argument("--base-case", type=float, default=64.0, help="wall seconds of one run of the 3600 s "
+                        "base case (docs/field-case.md: 64 s)")
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     scene = hfgpu.load_scene(SCENE)

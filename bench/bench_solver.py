@@ -12,9 +12,12 @@ Jacobian and its factorisation or the GMRES solve, one residual and one monotoni
 gather (once per active set) is timed apart. Each timing is the best of --repeat runs.
 
 Usage: OMP_NUM_THREADS=1 python bench/bench_solver.py [--sizes 100,300,1000,2000,3000,5000] [--aspects 1,5,20]
-       [--repeat 3] [--fit]
+       [--repeat 3] [--fit] [--near-field-radius 1]
 
---fit refits the model's constants to the timings (least squares on the logs) and prints them.
+--fit refits the model's constants to the timings (non-negative least squares on the relative errors) and prints them.
+--near-field-radius sets how many cells of C the Newton-Krylov preconditioner keeps (newton.NEAR_FIELD_RADIUS):
+the measured Krylov seconds and GMRES iterations are then that preconditioner's (the model's columns stay those of
+the fitted constants).
 """
 
 from __future__ import annotations
@@ -82,7 +85,9 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--coupling", type=float, default=COUPLING)
     parser.add_argument("--fit", action="store_true")
+    parser.add_argument("--near-field-radius", type=int, default=newton.NEAR_FIELD_RADIUS)
     args = parser.parse_args()
+    newton.NEAR_FIELD_RADIUS = args.near_field_radius
     model = CostModel()
     print(f"{'aspect':>6} {'n':>6} {'box':>9} {'thin':>5} {'dense s':>9} {'gather s':>9} {'krylov s':>9} "
           f"{'gmres':>6} {'model d':>9} {'model k':>9} {'pick':>7} {'best':>7}")

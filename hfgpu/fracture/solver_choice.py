@@ -2,9 +2,9 @@
 
 Per active set (simulator._Engine._rebuild) "auto" picks the dense LU (newton.py: the Jacobian gathered dense,
 scipy.linalg.lu_factor) or Newton-Krylov (GMRES with C applied by FFT over the footprint's bounding box,
-left-preconditioned by a SuperLU of the Jacobian with C cut to its radius-2 near field), whichever the model
-says is cheaper per Newton iteration. When the scene sets ``[fracture] krylov_threshold`` the fixed count rule
-applies instead (dense below that many cells).
+left-preconditioned by a SuperLU of the Jacobian with C cut to its near field, newton.NEAR_FIELD_RADIUS),
+whichever the model says is cheaper per Newton iteration. When the scene sets ``[fracture] krylov_threshold``
+the fixed count rule applies instead (dense below that many cells).
 
 The model counts work from the footprint alone (deterministic: the same scene picks the same solvers on any
 machine), with constants in seconds measured on one core (bench/bench_solver.py --fit, elliptic footprints of
@@ -51,22 +51,23 @@ class CostModel:
     """Seconds of each path per Newton iteration and per time step (module docstring); constants from
     bench/bench_solver.py --fit (one core)."""
 
-    d0: float = 1.8e-3        # dense: fixed cost of a factorised iteration [s]
-    d2: float = 3.0e-8        # dense: n^2 work of a factorised iteration (J = -dt L C, solves) [s]
-    d3: float = 2.35e-11      # dense: n^3 work (the LU) [s]
-    k0: float = 0.0           # Krylov: fixed cost of a factorisation [s]
-    kn: float = 0.0           # Krylov: n work of a factorisation (Jacobian, near field) [s]
-    ks: float = 1.52e-8       # Krylov: n t^2 work of a factorisation (SuperLU fill) [s]
-    kg: float = 6.5e-4        # Krylov: fixed cost of a GMRES iteration [s]
-    kf: float = 1.79e-8       # Krylov: P log2 P work of a GMRES iteration (FFT matvec) [s]
-    kp: float = 5.4e-8        # Krylov: n t work of a GMRES iteration (preconditioner solve) [s]
-    gmres_iterations: float = 5.0      # GMRES iterations of a fresh iteration in the benchmark (rtol 1e-3)
-    # per time step, with Jacobian reuse (measured on the height-contained example and radial_long):
+    d0: float = 4.9e-4        # dense: fixed cost of a factorised iteration [s]
+    d2: float = 9.2e-9        # dense: n^2 work of a factorised iteration (J = -dt L C, solves) [s]
+    d3: float = 1.23e-11      # dense: n^3 work (the LU) [s]
+    k0: float = 1.0e-3        # Krylov: fixed cost of a factorisation [s]
+    kn: float = 3.5e-6        # Krylov: n work of a factorisation (Jacobian, near field) [s]
+    ks: float = 9.5e-10       # Krylov: n t^2 work of a factorisation (SuperLU fill) [s]
+    kg: float = 1.4e-4        # Krylov: fixed cost of a GMRES iteration [s]
+    kf: float = 0.0           # Krylov: P log2 P work of a GMRES iteration (FFT matvec; the fit gives it to kg, kp) [s]
+    kp: float = 1.26e-8       # Krylov: n t work of a GMRES iteration (preconditioner solve) [s]
+    gmres_iterations: float = 7.5      # GMRES iterations of a fresh iteration in the benchmark (rtol 1e-3)
+    # per time step, with Jacobian reuse (Krylov: the height-contained example to 145 s, 290 steps, 398
+    # factorisations, 12 644 GMRES iterations; dense: the same example to 6 s and radial_long):
     dense_factorisations: float = 2.2  # LU factorisations a step
     dense_extra: float = 7.0e-8        # n^2 work a step besides them: C gathered once per active set (~2.5e-8)
                                        # and ~8 chord iterations (a residual and an LU solve each)
-    krylov_factorisations: float = 1.5  # SuperLU factorisations a step (the preconditioner is reused)
-    krylov_gmres: float = 25.0         # GMRES iterations a step (~5 Newton iterations of ~5 at rtol 1e-3)
+    krylov_factorisations: float = 1.4  # SuperLU factorisations a step (the preconditioner is reused)
+    krylov_gmres: float = 44.0         # GMRES iterations a step (~6.2 Newton iterations of ~7 at rtol 1e-3)
 
     @staticmethod
     def dense_terms(f: Footprint) -> list[float]:
