@@ -6,12 +6,12 @@ and "viscosity" (radial_viscosity.toml, K_Ic 0: the pure-viscosity fracture PyFr
 start on 0.1 m cells and are merged 3x3 whenever the footprint spans more than --max-cells-across cells, once
 per cap, tip asymptote, front, coarsening factor and linear solver listed (the speed-accuracy trade of the
 coarsening cap). A case whose scene uses the sub-grid front (II, IV) also runs with whole cells opening
-(front_tracking = "cells"), the faster and less accurate front. Errors are against Dontsov's (2016) universal solution (the M vertex of Savitski & Detournay
-(2002) where K_Ic = C_L = 0): of the front's mean, smallest and largest radius, of the radius from the area
-(sqrt(area / pi), tip cells by their filled fraction, hfgpu/fracture/geometry.py) and of the inlet width at the
-end, and the largest |error| of the last two over the run (every accepted step after 10 t0, t0 the start time,
-from the balance records). The runs do not depend on ``[output] every`` (snapshots between steps are
-interpolated).
+(front_tracking = "cells"), the faster and less accurate front. Errors are against Dontsov's (2016) universal
+solution (the M vertex of Savitski & Detournay (2002) where K_Ic = C_L = 0): of the front's mean, smallest
+and largest radius, of the radius from the area (sqrt(area / pi), tip cells by their filled fraction,
+hfgpu/fracture/geometry.py) and of the inlet width at the end, and the largest |error| of the last two over
+the run (every accepted step after 10 t0, t0 the start time, from the balance records). The runs do not depend
+on ``[output] every`` (snapshots between steps are interpolated).
 
 Usage: OMP_NUM_THREADS=1 python bench/bench_fracture.py [--cases I,II,III,IV,long,viscosity]
        [--max-cells-across 24,30,36] [--tip-asymptotes km,universal] [--fronts cells,subgrid] [--factors 3,2]

@@ -14,7 +14,8 @@ gather (once per active set) is timed apart. Each timing is the best of --repeat
 Usage: OMP_NUM_THREADS=1 python bench/bench_solver.py [--sizes 100,300,1000,2000,3000,5000] [--aspects 1,5,20]
        [--repeat 3] [--fit] [--near-field-radius 1]
 
---fit refits the model's constants to the timings (non-negative least squares on the relative errors) and prints them.
+--fit refits the model's constants to the timings (non-negative least squares on the relative errors) and
+prints them.
 --near-field-radius sets how many cells of C the Newton-Krylov preconditioner keeps (newton.NEAR_FIELD_RADIUS):
 the measured Krylov seconds and GMRES iterations are then that preconditioner's (the model's columns stay those of
 the fitted constants).

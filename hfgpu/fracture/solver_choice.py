@@ -61,7 +61,7 @@ class CostModel:
     kf: float = 0.0           # Krylov: P log2 P work of a GMRES iteration (FFT matvec; the fit gives it to kg, kp) [s]
     kp: float = 1.26e-8       # Krylov: n t work of a GMRES iteration (preconditioner solve) [s]
     gmres_iterations: float = 7.5      # GMRES iterations of a fresh iteration in the benchmark (rtol 1e-3)
-    # per time step, with Jacobian reuse (Krylov: the height-contained example to 145 s, 290 steps, 398
+    # per time step, with Jacobian reuse (Krylov: the height-contained example to 145 s, 290 steps, 399
     # factorisations, 12 644 GMRES iterations; dense: the same example to 6 s and radial_long):
     dense_factorisations: float = 2.2  # LU factorisations a step
     dense_extra: float = 7.0e-8        # n^2 work a step besides them: C gathered once per active set (~2.5e-8)
