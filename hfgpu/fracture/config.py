@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from ..presets import BALANCED, Preset
 from ..scene_reader import Table
+from .tip_cells import RIBBON_FITS
 
 
 @dataclass(frozen=True)
@@ -37,6 +38,9 @@ class FractureNumerics:
         "subgrid" (tip cells: the front crosses the cells around the channel by a distance found from the
         channel's widths through the inverted tip asymptote, their widths are the asymptote's mean over the
         crossed part and only that part leaks; see simulator.py).
+    ribbon_fit: with the sub-grid front, how a ribbon cell's width places the front: "two_term" (the tip
+        asymptote times a linear correction fitted through the ribbon and its inner neighbour) or "asymptote"
+        (the asymptote's inverse alone); tip_cells.py has the equation and the measurements.
     leakoff_clock: a cell whose leak-off the positivity ramp held below Carter's demand continues from the
         exposure time its leaked volume corresponds to (leakoff.carter_demand), so time spent dry does not
         count as exposure; off: Carter's law from the opening time, whatever the cell leaked.
@@ -57,6 +61,7 @@ class FractureNumerics:
     max_front_advance: float = 1.0
     leakoff_clock: bool = True
     front_tracking: str = "cells"
+    ribbon_fit: str = "two_term"
 
 
 def parse_fracture_numerics(t: Table, preset: Preset = BALANCED) -> FractureNumerics:
@@ -82,6 +87,7 @@ def parse_fracture_numerics(t: Table, preset: Preset = BALANCED) -> FractureNume
         max_front_advance=t.number("max_front_advance", d.max_front_advance, minimum=0.1, maximum=10.0),
         leakoff_clock=t.boolean("leakoff_clock", d.leakoff_clock),
         front_tracking=t.choice("front_tracking", ("cells", "subgrid"), d.front_tracking),
+        ribbon_fit=t.choice("ribbon_fit", RIBBON_FITS, d.ribbon_fit),
     )
     t.finish()
     return numerics

@@ -30,7 +30,7 @@ class Grid:
 
     FILL = {"active": False, "w": 0.0, "opened": np.nan, "filled": np.nan, "reached": np.nan, "leak_rate": 0.0, "p": 0.0,
             "leaked": 0.0, "fill": 0.0,
-            "advance": np.nan}
+            "advance": np.nan, "w_rate": 0.0}
 
     @classmethod
     def around_injection(cls, dx: float, dz: float, x_inj: float, z_inj: float, half: int) -> "Grid":

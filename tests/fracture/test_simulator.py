@@ -106,6 +106,8 @@ def test_bad_input_is_rejected_before_work_starts():
         load_scene(scene_text(fracture='[fracture]\npartial_tip_cells = 3'))
     with pytest.raises(SceneError, match="fracture.front_tracking.*subgrid"):
         load_scene(scene_text(fracture='[fracture]\nfront_tracking = "level set"'))
+    with pytest.raises(SceneError, match="fracture.ribbon_fit.*two_term"):
+        load_scene(scene_text(fracture='[fracture]\nribbon_fit = "quadratic"'))
     with pytest.raises(SceneError, match="fracture.initial_radius_cells"):
         simulate(scene(end_time="0.001 s", cell="1 m"), MemorySink())
 
@@ -129,14 +131,21 @@ def test_newton_failure_raises_simulation_error_with_time_cell_and_residual():
     assert "Newton" in str(err)
 
 
-def test_a_step_that_cannot_shrink_enough_stops_the_run_with_a_message():
-    """A sub-grid front that moves more than max_front_advance cells however short the step (here a limit
-    far below what the scene validates, set on the frozen config directly) halves its steps until they fall
-    below MIN_STEP_FRACTION of the time: a SimulationError naming the knob, not a division by zero."""
-    base = scene(**FAST, fracture='[fracture]\nfront_tracking = "subgrid"')
-    sc = base.replace(fracture=dataclasses.replace(base.fracture, max_front_advance=1e-9))
+def test_a_step_that_cannot_shrink_enough_stops_the_run_with_a_message(monkeypatch):
+    """A sub-grid front that moves more than max_front_advance cells however short the step (forced here:
+    every step reports twice the limit) halves its steps until they fall below MIN_STEP_FRACTION of the time:
+    a SimulationError naming the knob, not a division by zero."""
+    from hfgpu.fracture import simulator
+
+    iterate = simulator._Engine._front_iterations
+
+    def too_far(eng, dt, start):
+        res, _, converged = iterate(eng, dt, start)
+        return res, 2.0 * eng.num.max_front_advance * min(eng.dx, eng.dz), converged
+
+    monkeypatch.setattr(simulator._Engine, "_front_iterations", too_far)
     with pytest.raises(SimulationError, match="max_front_advance") as info:
-        simulate(sc, MemorySink())
+        simulate(scene(**FAST, fracture='[fracture]\nfront_tracking = "subgrid"'), MemorySink())
     assert info.value.time is not None
 
 

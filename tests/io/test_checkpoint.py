@@ -50,6 +50,11 @@ every = "10 s"
 checkpoint_every = "7 s"
 """
 
+#: The same with the sub-grid front, whose steps start Newton from the last step's dw/dt (grid field w_rate).
+FRACTURE_SUBGRID = FRACTURE + """[fracture]
+front_tracking = "subgrid"
+"""
+
 #: Slot with an inlet, an outlet and a pad after the slurry: 62 fluid steps, about a second.
 PROPPANT = """
 [run]
@@ -162,7 +167,8 @@ def reference(tmp_path_factory):
     """Uninterrupted runs without checkpoints: {"fracture": path, "proppant": path, "coupled": path}."""
     folder = tmp_path_factory.mktemp("reference")
     paths = {}
-    for name, text in (("fracture", FRACTURE), ("proppant", PROPPANT), ("coupled", COUPLED)):
+    for name, text in (("fracture", FRACTURE), ("subgrid", FRACTURE_SUBGRID), ("proppant", PROPPANT),
+                       ("coupled", COUPLED)):
         paths[name] = folder / f"{name}.h5"
         summary = hfgpu.run(load_scene(_no_checkpoints(text)), paths[name], progress=False)
         assert summary["checkpoints"] == 0
@@ -172,17 +178,18 @@ def reference(tmp_path_factory):
 # -- resumed runs equal uninterrupted ones ----------------------------------------------------------------
 
 
-@pytest.mark.parametrize("name, after, steps", [("fracture", 3, 5), ("proppant", 3, 4)])
+@pytest.mark.parametrize("name, after, steps", [("fracture", 3, 5), ("subgrid", 3, 5), ("proppant", 3, 4)])
 def test_resumed_run_equals_the_uninterrupted_one(name, after, steps, reference, tmp_path, monkeypatch):
-    text = FRACTURE if name == "fracture" else PROPPANT
+    text = {"fracture": FRACTURE, "subgrid": FRACTURE_SUBGRID, "proppant": PROPPANT}[name]
+    kind = "proppant" if name == "proppant" else "fracture"
     path = tmp_path / "resumed.h5"
     _interrupted(monkeypatch, text, path, after, steps)
     cut = open_results(path)
     assert cut.status.startswith("failed") and cut.checkpoint_time is not None
     with h5py.File(path, "r") as f:  # records past the checkpoint, for the resume to drop
         kept = f["checkpoint"].attrs
-        assert kept[f"{name}_balance_rows"] < getattr(cut, f"{name}_balance")["time"].size
-        assert kept[f"{name}_snapshots"] < len(getattr(cut, f"{name}_snapshots"))
+        assert kept[f"{kind}_balance_rows"] < getattr(cut, f"{kind}_balance")["time"].size
+        assert kept[f"{kind}_snapshots"] < len(getattr(cut, f"{kind}_snapshots"))
     summary = hfgpu.run(load_scene(text), path, progress=False, resume=True)
     assert summary["resumed_from"] == cut.checkpoint_time and summary["checkpoints"] >= 1
     assert open_results(path).status == "complete" and open_results(path).checkpoint_time is None
