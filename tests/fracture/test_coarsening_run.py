@@ -118,7 +118,7 @@ def test_pure_viscosity_radial_case_with_the_sub_grid_front_and_2x_remeshing():
     10 to 20 cells per radius, as PyFrac's example) against the M vertex at the end and at every accepted step
     after 10 t0. Measured: end R -0.02 %, w(0) -0.47 %; over the run within 0.57 % (R) and 1.64 % (w(0), the
     inlet cell's mean just after a remeshing); 240 steps (issue 19: 1 % at the end, 2 % over the run). With
-    ``ribbon_fit = "asymptote"``: end -1.24 / +1.09 %, over the run 1.77 / 1.58 %."""
+    ``ribbon_fit = "asymptote"``: end -1.24 / +1.08 %, over the run 1.77 / 1.58 %."""
     out, radius, inlet = _against_m_vertex("radial_viscosity_subgrid.toml")
     assert out["coarsenings"] == 8 and out["max_balance_error"] < 1e-9
     assert abs(radius[-1]) < 0.01 and abs(inlet[-1]) < 0.01
