@@ -304,10 +304,10 @@ def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nd
             continue
         x = x + step * dx
         r = trial
-        if np.linalg.norm(dx) < tolerance * max(np.linalg.norm(x), 1e-300):   # undamped update
+        limit = tolerance * max(np.linalg.norm(x), 1e-300)
+        if np.linalg.norm(dx) < limit:   # undamped update
             return x, True, it, precond
-        if (simplified_exit and step == 1.0
-                and np.linalg.norm(simplified) < tolerance * max(np.linalg.norm(x), 1e-300)):
+        if simplified_exit and step == 1.0 and np.linalg.norm(simplified) < limit:
             return x + _volume_exact(prob, r, simplified, closed), True, it, precond
         reuse = (REUSE_JACOBIAN and accepted and step == 1.0
                  and np.linalg.norm(simplified) <= REUSE_CONTRACTION * scale)

@@ -309,7 +309,8 @@ class _Engine:
                            demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted)
         closed = g.shut(self.t)[sel] if pinned is None else None   # the last step's contact set
         with blas_threads(self.ix.size):
-            res = solve_step(prob, self.elastic, tolerance or self.num.newton_tolerance, self.num.newton_max_iterations,
+            res = solve_step(prob, self.elastic, tolerance or self.num.newton_tolerance,
+                             self.num.newton_max_iterations,
                              None if w_start is None else np.where(w_start > 0.0, w_start, start_widths(prob)),
                              closed, preconditioner, simplified_exit)
         self.newton_iterations += res.iterations

@@ -28,11 +28,11 @@ sigma = s + Delta, Delta = h |n_axis|, n = -grad w / |grad w| by central differe
     G(s) = w_2 / w_a(s + Delta) - 1 - (s + Delta) / s (w_1 / w_a(s) - 1) = 0,
 
 with the asymptote's V the ribbon's (at least (s - s_0) / dt, as the one-term distance). Its root, by the
-Illinois method (``_illinois``) inside [s_1 / 2, 2 s_1] (s_1: the one-term distance), places the front from the
-exact M-vertex widths at the cell centres of a 10-cells-per-radius grid within +0.11 % of R on average (worst
-+0.21 %), against -0.44 % (worst -0.79 %) from the asymptote alone (tests/fracture/test_subgrid_front.py). A
-ribbon whose bracket holds no root, whose inner neighbour is not a channel cell or not wider, or whose
-correction |b (s + Delta)| exceeds FIT_MAX_CORRECTION keeps s_1.
+Illinois method on ln s (tip_universal.increasing_root) inside [s_1 / 2, 2 s_1] (s_1: the one-term distance),
+places the front from the exact M-vertex widths at the cell centres of a 10-cells-per-radius grid within
++0.11 % of R on average (worst +0.21 %), against -0.44 % (worst -0.79 %) from the asymptote alone
+(tests/fracture/test_subgrid_front.py). A ribbon whose bracket holds no root, whose inner neighbour is not a
+channel cell or not wider, or whose correction |b (s + Delta)| exceeds FIT_MAX_CORRECTION keeps s_1.
 """
 
 from __future__ import annotations
@@ -42,11 +42,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .front import OLSON, TipModel, _per_direction, _shift, _tip_cells, invert_tip, tip_width
+from .tip_universal import increasing_root
 
 QUADRATURE = 8
 _OFFSETS = (np.arange(QUADRATURE) + 0.5) / QUADRATURE - 0.5
 LAYERS = 3   # cells marched out from the ribbons: the front may cross cells within a step (max_front_advance)
-ROOT_ITERATIONS = 16         # Illinois iterations of the ribbons' distances (``_illinois``)
 FIT_MAX_CORRECTION = 0.5     # the largest |b (s + Delta)| the fit may apply
 RIBBON_FITS = ("two_term", "asymptote")
 
@@ -88,11 +88,10 @@ def _two_term_distance(channel: np.ndarray, w: np.ndarray, ribbon: np.ndarray, a
     """(s, V) of the ribbons (in the order of ``ribbon``) by the two-term fit of the module docstring; ``args``
     (model, K', C', w) at the ribbons as for front.invert_tip; s_1, v_1 the one-term distance and speed, kept
     where the fit does not apply."""
-    padded = np.pad(w, 1)
-    gx = (padded[1:-1, 2:] - padded[1:-1, :-2]) / (2.0 * dx)
-    gz = (padded[2:, 1:-1] - padded[:-2, 1:-1]) / (2.0 * dz)
     k, i = np.nonzero(ribbon)
-    gx, gz = gx[k, i], gz[k, i]
+    padded = np.pad(w, 1)   # the width gradient at the ribbons, by central differences
+    gx = (padded[k + 1, i + 2] - padded[k + 1, i]) / (2.0 * dx)
+    gz = (padded[k + 2, i + 1] - padded[k, i + 1]) / (2.0 * dz)
     along_x = np.abs(gx) >= np.abs(gz)
     # the inner neighbour: one cell up the width gradient along the axis nearer the normal
     ki = np.clip(np.where(along_x, k, k + np.sign(gz).astype(int)), 0, w.shape[0] - 1)
@@ -109,8 +108,8 @@ def _two_term_distance(channel: np.ndarray, w: np.ndarray, ribbon: np.ndarray, a
     g_lo, g_hi = fit.gap(lo)[0], fit.gap(hi)[0]
     bracketed = np.sign(g_lo) != np.sign(g_hi)   # (NaN never differs)
     at, fit = at[bracketed], fit.subset(bracketed)
-    root = np.clip(_illinois(lambda x: fit.gap(x)[0], lo[bracketed], hi[bracketed], g_lo[bracketed],
-                             g_hi[bracketed]), lo[bracketed], hi[bracketed])
+    rising = np.sign(g_hi[bracketed])   # G's orientation over each bracket
+    root = increasing_root(lambda x: rising * fit.gap(x)[0], lo[bracketed], hi[bracketed])
     _, b, speed = fit.gap(root)
     good = np.abs(b * (root + fit.delta)) <= FIT_MAX_CORRECTION
     s[at[good]], v[at[good]] = root[good], speed[good]
@@ -144,50 +143,23 @@ class _TwoTerm:
         return self.w_2 / far - 1.0 - b * (s + self.delta), b, speed
 
 
-def _illinois(func, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: np.ndarray,
-              iterations: int = ROOT_ITERATIONS) -> np.ndarray:
-    """Roots of the elementwise function ``func`` inside brackets [lo, hi] where f_lo, f_hi differ in sign: the
-    Illinois variant of regula falsi (the end kept twice in a row has its value halved), superlinear and
-    never leaving the bracket; at most ``iterations``, fewer once no iterate moves by more than 1e-13 of its
-    magnitude."""
-    kept = np.zeros(lo.shape)   # +1: the last iterate replaced lo, -1: hi
-    previous = None
-    for _ in range(iterations):
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mid = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-        mid = np.where(np.isfinite(mid), mid, 0.5 * (lo + hi))
-        if previous is not None and np.all(np.abs(mid - previous) <= 1e-13 * np.abs(mid)):
-            return mid
-        previous = mid
-        f_mid = func(mid)
-        low = np.sign(f_mid) == np.sign(f_lo)
-        f_hi = np.where(low & (kept == 1), 0.5 * f_hi, f_hi)
-        f_lo = np.where(~low & (kept == -1), 0.5 * f_lo, f_lo)
-        lo, f_lo = np.where(low, mid, lo), np.where(low, f_mid, f_lo)
-        hi, f_hi = np.where(low, hi, mid), np.where(low, f_hi, f_mid)
-        kept = np.where(low, 1, -1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        root = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-    return np.where(np.isfinite(root), root, 0.5 * (lo + hi))
-
-
 def _implicit_distance(args: tuple, s: np.ndarray, v: np.ndarray, s_0: np.ndarray,
                        dt: float) -> tuple[np.ndarray, np.ndarray]:
     """(s, V) of ``ribbon_distances`` with V = max(v, (s - s_0) / dt): where s (at speed v) lies beyond
     s_0 + v dt, the root of invert_tip(w, (s - s_0) / dt) = s between s_0 + v dt and s (the inverse falls as V
-    rises, so the root is unique), by ``_illinois`` in u = ln(s - s_0), where the inverse is close to a power
-    law (32 iterations: to round-off from brackets spanning 16 decades; bisection took 50); unchanged elsewhere."""
+    rises, so the root is unique), by tip_universal.increasing_root in the advance a = s - s_0 (Illinois on
+    ln a, where the inverse is close to a power law); unchanged elsewhere."""
     fast = np.isfinite(s_0) & (s > s_0 + v * dt)
     if not fast.any():
         return s, v
     base, span = s_0[fast], s[fast] - s_0[fast]
     sub = tuple(a[fast] for a in args[1:])
 
-    def gap(u):
-        return invert_tip(args[0], *sub, np.exp(u) / dt) - base - np.exp(u)
+    def excess(a):   # increasing in the advance a
+        return base + a - invert_tip(args[0], *sub, a / dt)
 
-    lo, hi = np.log(np.maximum(v[fast] * dt, 1e-12 * span)), np.log(span)
-    advance = np.exp(np.clip(_illinois(gap, lo, hi, gap(lo), gap(hi), 2 * ROOT_ITERATIONS), lo, hi))
+    lo = np.maximum(v[fast] * dt, 1e-12 * span)
+    advance = np.clip(increasing_root(excess, lo, span), lo, span)
     s, v = s.copy(), v.copy()
     s[fast] = base + advance
     v[fast] = advance / dt

@@ -113,9 +113,9 @@ def _vertex_widths(s, e_prime, k_prime, c_prime, mu_prime, v):
     return np.maximum(np.maximum(w_k, w_m), w_mt)
 
 
-def _solve(fun, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """Root of fun(x), increasing in x, per element: lo and hi are widened by factors of 4 until they bracket
-    it, then Illinois regula falsi on ln x to a relative change of RTOL."""
+def increasing_root(fun, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Root of fun(x), increasing in x > 0, per element: lo and hi are widened by factors of 4 until they bracket
+    it, then Illinois regula falsi on ln x to a relative change of RTOL (also tip_cells' ribbon distances)."""
     f_lo, f_hi = fun(lo), fun(hi)
     for _ in range(ITERATIONS):
         low, high = f_lo > 0.0, f_hi < 0.0
@@ -155,7 +155,7 @@ def width(s, e_prime, k_prime, c_prime, mu_prime, v) -> np.ndarray:
         args = (e_prime, k_prime[moving], c_prime[moving], mu_prime, v[moving])
         sm = s[moving]
         lo = _vertex_widths(sm, *args)
-        w[moving] = _solve(lambda x: -_residual(x, sm, *args), lo, 3.0 * lo)
+        w[moving] = increasing_root(lambda x: -_residual(x, sm, *args), lo, 3.0 * lo)
     return w
 
 
@@ -177,5 +177,5 @@ def distance(w, e_prime, k_prime, c_prime, mu_prime, v) -> np.ndarray:
         hi = np.minimum(s[moving], (wm / m_scale(e_prime, mu_prime, vm)) ** 1.5)
         with np.errstate(divide="ignore"):
             hi = np.minimum(hi, (wm / (BETA_MT * (2.0 * cm * mu_prime / e_prime) ** 0.25 * vm**0.125)) ** 1.6)
-        s[moving] = _solve(lambda x: _residual(wm, x, *args), hi / 9.0, hi)
+        s[moving] = increasing_root(lambda x: _residual(wm, x, *args), hi / 9.0, hi)
     return s
