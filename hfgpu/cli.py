@@ -13,6 +13,7 @@ import signal
 import sys
 from pathlib import Path
 
+from . import __version__
 from .errors import HfgpuError
 from .interrupts import signal_number
 
@@ -20,6 +21,7 @@ from .interrupts import signal_number
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="hfgpu", description="Hydraulic fracture and proppant transport "
                                      "simulator (planar 3-D fracture, MP-PIC proppant).")
+    parser.add_argument("--version", action="version", version=f"hfgpu {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     run = commands.add_parser("run", help="run a scene and write a results file")

@@ -49,6 +49,7 @@ import numpy as np
 
 from .coupling import FractureHistory, bridging_risk, proppant_frame
 from .errors import SceneError
+from .fracture.mesh import injection_cell_centre
 from .fracture.simulator import simulate as simulate_fracture
 from .proppant.config import Geometry, Port
 from .proppant.simulator import ProppantSimulation, warn_screen_out
@@ -156,7 +157,8 @@ def proppant_scene(scene: Scene, frame: GridFrame, shape: tuple[int, int], width
     x, z = frame.centres(nz, nx)
     inj, cfg = scene.injection, scene.coupling
     outer = cfg.inlet_radius if cfg.inlet_radius is not None else DEFAULT_INLET_CELLS * max(frame.dx, frame.dz)
-    inlet = Port("annulus", x=inj.x, depth=inj.depth, inner_radius=cfg.inlet_inner_radius, outer_radius=outer)
+    x_inj, z_inj = injection_cell_centre(scene)   # the fracture's source cell, which holds the perforation
+    inlet = Port("annulus", x=x_inj, depth=z_inj, inner_radius=cfg.inlet_inner_radius, outer_radius=outer)
     geometry = Geometry(kind="field", length=nx * frame.dx, height=nz * frame.dz, field_x=x, field_z=z,
                         field_w=np.asarray(width, dtype=np.float64), inlets=(inlet,))
     return scene.replace(
@@ -310,11 +312,11 @@ def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None =
     history = FractureHistory(tee.snapshots)
     timings.seconds["fracture"] += _time.perf_counter() - t0 - timings.seconds["io"]
     start = late_start(scene, start, float(history.times[0]))
-    inj = scene.injection
-    frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=(inj.x, inj.depth))
+    frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=injection_cell_centre(scene))
     field = history.width_field(frame, shape, cfg.min_width)
     sub = proppant_scene(scene, frame, shape, field(start)[0], start)
     sim = ProppantSimulation(sub, width_field=lambda t: field(t + start))
+    sim.watch.offset = start
     sim.solver.step = timings.wrap("fluid", sim.solver.step)
     sim.engine.substeps = timings.wrap("parcels", sim.engine.substeps)
     shift = _ProppantShift(sink, start, scene.proppant.params.bridging_factor, timings)

@@ -183,7 +183,8 @@ class FractureHistory:
     def injection_point(self) -> tuple[float, float]:
         """(x, z) of the injection cell's centre, estimated from the first snapshot: the centroid of the
         cells that opened first (the injection cell, or the seed disc centred on it), moved to the nearest
-        cell centre of that snapshot (the fracture grid keeps the injection point at a cell centre)."""
+        cell centre of that snapshot (the fracture grid's injection cell holds the injection point, its
+        centre up to half a cell from it: hfgpu.fracture.mesh)."""
         snap = self.snapshot(0)
         opened = np.asarray(snap.opening_time, dtype=np.float64)
         if not np.isfinite(opened).any():
@@ -210,8 +211,10 @@ def proppant_frame(history: FractureHistory, cell_size: float | tuple[float, flo
                    margin: int = 1, source: tuple[float, float] | None = None) -> tuple[GridFrame, Shape]:
     """The fixed proppant grid (frame, (nz, nx)): cells of ``cell_size`` [m] (default: the finest fracture
     cells) covering the largest footprint (union over the snapshots of the open cells' bounding boxes) plus
-    ``margin`` cells on each side, placed so that the injection point ``source`` (default
-    :meth:`FractureHistory.injection_point`) is a cell centre."""
+    ``margin`` cells on each side, placed so that ``source`` is a cell centre: the fracture's injection cell's
+    centre (default :meth:`FractureHistory.injection_point`; exact: hfgpu.fracture.mesh.injection_cell_centre),
+    so that proppant cells of the fracture's size coincide with its cells and the layer boundaries on their
+    faces stay on faces."""
     if not (isinstance(margin, (int, np.integer)) and margin >= 0):
         raise ValueError(f"proppant_frame: margin = {margin!r}; must be an integer >= 0 (cells)")
     dx, dz = _cell_size(cell_size, history)

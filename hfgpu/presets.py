@@ -30,7 +30,8 @@ class Preset:
     Eq. 35 and epsilon of Eq. 32. simple_tolerance [mppic]: Algorithm 1's stopping rule; parcels_per_cell:
     parcels filling a cell at a class's largest loading (sets particles per parcel); particle_substeps:
     particle sub-steps per fluid step (section 4.3); c_max: Courant limit of Eq. 42; dt_max: cap of the
-    fluid step [s].
+    fluid step [s]. time_scale, parcel_budget: the factor on a coupled scene's derived coupling interval and
+    step cap, and its largest parcel count (hfgpu.defaults).
     """
 
     name: str
@@ -42,16 +43,21 @@ class Preset:
     particle_substeps: int
     c_max: float
     dt_max: float
+    time_scale: float
+    parcel_budget: int
 
 
 #: The one table of presets, fastest first (read-only).
 PRESETS: MappingProxyType[str, Preset] = MappingProxyType({p.name: p for p in (
     Preset("fast", refinement=0.5, time_step_relaxation=1.0, newton_tolerance=1e-4, simple_tolerance=1e-4,
-           parcels_per_cell=4, particle_substeps=2, c_max=0.8, dt_max=0.1),
+           parcels_per_cell=4, particle_substeps=2, c_max=0.8, dt_max=0.1, time_scale=2.0,
+           parcel_budget=20_000),
     Preset("balanced", refinement=1.0, time_step_relaxation=0.5, newton_tolerance=1e-6, simple_tolerance=1e-5,
-           parcels_per_cell=16, particle_substeps=4, c_max=0.5, dt_max=0.05),
+           parcels_per_cell=16, particle_substeps=4, c_max=0.5, dt_max=0.05, time_scale=1.0,
+           parcel_budget=60_000),
     Preset("accurate", refinement=2.0, time_step_relaxation=0.25, newton_tolerance=1e-7,
-           simple_tolerance=1e-6, parcels_per_cell=32, particle_substeps=8, c_max=0.3, dt_max=0.02),
+           simple_tolerance=1e-6, parcels_per_cell=32, particle_substeps=8, c_max=0.3, dt_max=0.02, time_scale=0.4,
+           parcel_budget=200_000),
 )})
 DEFAULT_PRESET = "balanced"
 BALANCED = PRESETS[DEFAULT_PRESET]
@@ -70,18 +76,24 @@ KNOBS: tuple[tuple[str, str, str | None], ...] = (
 
 
 def effective_knobs(scene: Any) -> list[tuple[str, Any, str]]:
-    """(key path, value in use, where it came from: "scene" or "preset <name>") of each preset knob the
-    scene's physics reads; the origin is read from the scene's TOML text (``scene.source``)."""
+    """(key path, value in use, where it came from: "scene", "preset <name>" or "from the scene: <reason>", a
+    default computed from the scene's scales, hfgpu.defaults) of each preset knob the scene's physics reads and
+    of each derived one; the origin is read from the scene's TOML text (``scene.source``)."""
     data = tomllib.loads(scene.source) if scene.source else {}
     objects = {"mesh": scene.mesh, "fracture": scene.fracture,
                "mppic": scene.proppant.numerics if scene.proppant is not None else None}
+    derived = {d.key: d for d in scene.derived}
     rows = []
     for section, key, physics in KNOBS:
         if physics is not None and not scene.has(physics):
             continue
+        path = f"{section}.{key}"
         given = isinstance(data.get(section), dict) and key in data[section]
-        rows.append((f"{section}.{key}", getattr(objects[section], key),
-                     "scene" if given else f"preset {scene.run.preset}"))
+        origin = "scene" if given else (f"from the scene: {derived[path].reason}" if path in derived
+                                        else f"preset {scene.run.preset}")
+        rows.append((path, getattr(objects[section], key), origin))
+    rows += [(d.key, d.value, f"from the scene: {d.reason}") for d in scene.derived
+             if d.key not in {path for path, _, _ in rows}]
     return rows
 
 

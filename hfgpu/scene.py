@@ -30,8 +30,8 @@ else:  # pragma: no cover
 
 from .errors import SceneError
 from .presets import DEFAULT_PRESET, PRESETS, Preset
-from .scene_reader import Table, collecting_warnings, raise_all
-from .units import majority_system
+from .scene_reader import Table, collecting_warnings, raise_all, scene_system, warn
+from .units import SYSTEMS, convert, display_text, majority_system
 
 PHYSICS = ("fracture", "proppant")
 
@@ -49,7 +49,10 @@ class RunConfig:
 
 @dataclass(frozen=True)
 class Layer:
-    """A horizontal layer between depths ``top`` < ``bottom`` [m]; None means "use the rock's value"."""
+    """A horizontal layer between depths ``top`` < ``bottom`` [m]; None means "use the rock's value".
+
+    The layer's stress at depth z is sigma_0(z) = ``min_stress`` + ``min_stress_gradient`` z (a scene's
+    ``min_stress = "0.75 psi/ft"`` gives min_stress 0 and the gradient; a pressure gives gradient 0)."""
 
     top: float
     bottom: float
@@ -57,10 +60,14 @@ class Layer:
     toughness: float | None = None
     leakoff_coefficient: float | None = None
     pore_pressure: float | None = None
+    min_stress_gradient: float = 0.0
 
 
 @dataclass(frozen=True)
 class Rock:
+    """``[rock]``: sigma_0(z) = ``min_stress`` + ``min_stress_gradient`` z [Pa] where no layer gives a stress (as
+    :class:`Layer`)."""
+
     youngs_modulus: float
     poisson_ratio: float
     toughness: float
@@ -68,16 +75,20 @@ class Rock:
     min_stress: float
     layers: tuple[Layer, ...] = ()
     pore_pressure: float = 0.0
+    min_stress_gradient: float = 0.0
 
     @property
     def plane_strain_modulus(self) -> float:
         """E' = E / (1 - nu^2), Eq. 1."""
         return self.youngs_modulus / (1.0 - self.poisson_ratio**2)
 
-    def _layered(self, z: np.ndarray, name: str) -> np.ndarray:
-        """Property ``name`` at depths ``z``; the outermost layers extend to +-infinity."""
+    def _layered(self, z: np.ndarray, name: str, gradient: str | None = None) -> np.ndarray:
+        """Property ``name`` (+ ``gradient`` x z when given) at depths ``z``; the outermost layers extend to
+        +-infinity."""
         z = np.asarray(z, dtype=float)
         out = np.full(z.shape, float(getattr(self, name)))
+        if gradient:
+            out += getattr(self, gradient) * z
         if not self.layers:
             return out
         ordered = sorted(self.layers, key=lambda layer: layer.top)
@@ -87,12 +98,14 @@ class Rock:
                 continue
             top = -math.inf if i == 0 else layer.top
             bottom = math.inf if i == len(ordered) - 1 else layer.bottom
-            out[(z >= top) & (z < bottom)] = value
+            inside = (z >= top) & (z < bottom)
+            out[inside] = value + (getattr(layer, gradient) if gradient else 0.0) * z[inside]
         return out
 
     def min_stress_at(self, z: np.ndarray) -> np.ndarray:
-        """Minimum in-situ stress sigma_0(z) [Pa] from the layer table."""
-        return self._layered(z, "min_stress")
+        """Minimum in-situ stress sigma_0(z) = sigma_c + (d sigma/dz) z [Pa] from the layer table, at each depth
+        z (the cell centres: a gradient is evaluated per cell)."""
+        return self._layered(z, "min_stress", "min_stress_gradient")
 
     def toughness_at(self, z: np.ndarray) -> np.ndarray:
         """K_Ic(z) [Pa m^0.5]."""
@@ -239,6 +252,8 @@ class Scene:
     source: str = field(default="", repr=False, compare=False)  # the TOML text, stored in results
     #: One line each: what the scene reader found suspect but valid (bare numbers); hfgpu.scene_checks adds more.
     warnings: tuple[str, ...] = field(default=(), repr=False, compare=False)
+    #: The knobs given defaults from the scene's own scales (hfgpu.defaults.Derived: key, value, reason).
+    derived: tuple[Any, ...] = field(default=(), repr=False, compare=False)
 
     def has(self, physics: str) -> bool:
         return physics in self.run.physics
@@ -286,11 +301,21 @@ def parse_scene(data: dict, source: str = "") -> Scene:
     errors of all sections (within a section, the first error stops it); a section that needs a failed one
     (``[[proppant]]`` needs ``[run]``, ``[fluid]`` and ``[mesh]``; ``[closure]`` needs ``[[proppant]]`` and
     ``[rock]``; ``[coupling]`` needs ``[run]`` and ``[mesh]``) is skipped, so that one mistake is reported once. The
-    warnings found while reading (bare numbers, :mod:`hfgpu.scene_reader`) are in ``Scene.warnings``.
+    warnings found while reading (bare numbers, :mod:`hfgpu.scene_reader`; gaps between layers; high proppant
+    concentrations) are in ``Scene.warnings``. Bare numbers are judged by the scene's unit system
+    (:func:`unit_system`).
     """
-    with collecting_warnings() as found:
+    with collecting_warnings(unit_system(data)) as found:
         scene = _parse(data, source)
     return dataclasses.replace(scene, warnings=tuple(found))
+
+
+def unit_system(data: dict) -> str:
+    """The unit system a scene is written in: ``[output] units`` when it names one, else the system most of its
+    unit-bearing values use (:func:`hfgpu.units.majority_system`)."""
+    output = data.get("output")
+    units = output.get("units") if isinstance(output, dict) else None
+    return units if isinstance(units, str) and units in SYSTEMS else majority_system(data)
 
 
 class _Sections:
@@ -392,8 +417,11 @@ def _parse(data: dict, source: str) -> Scene:
                                           'this section needs both "fracture" and "proppant" in run.physics'))
     sections((), top.finish)
     raise_all(sections.errors)
-    return Scene(run=run, fluid=fluid, mesh=mesh, output=output, rock=rock, injection=injection,
-                 fracture=fracture, proppant=proppant, coupling=coupling, closure=closure, source=source)
+    from .defaults import derive
+
+    scene = Scene(run=run, fluid=fluid, mesh=mesh, output=output, rock=rock, injection=injection,
+                  fracture=fracture, proppant=proppant, coupling=coupling, closure=closure, source=source)
+    return derive(scene, data, preset)[0]
 
 
 def _parse_run(t: Table) -> RunConfig:
@@ -469,9 +497,9 @@ def _parse_rock(t: Table) -> Rock:
             poisson_ratio=t.number("poisson_ratio", minimum=0.0, maximum=0.5, exclusive_maximum=True),
             toughness=t.quantity("toughness", "toughness", 0.0, minimum=0.0),
             leakoff_coefficient=t.quantity("leakoff_coefficient", "leakoff", 0.0, minimum=0.0),
-            min_stress=t.quantity("min_stress", "pressure", 0.0),
-            pore_pressure=t.quantity("pore_pressure", "pressure", 0.0),
         )
+        rock["min_stress"], rock["min_stress_gradient"] = t.stress("min_stress", 0.0)
+        rock["pore_pressure"] = t.quantity("pore_pressure", "pressure", 0.0)
     except SceneError as exc:
         errors.append(exc)
     layers: list[tuple[int, Layer]] = []
@@ -481,26 +509,56 @@ def _parse_rock(t: Table) -> Rock:
         except SceneError as exc:
             errors.append(exc)
     raise_all(errors)
-    ordered = sorted(layers, key=lambda item: item[1].top)
-    for (i, above), (j, below) in zip(ordered, ordered[1:]):
-        if below.top < above.bottom - 1e-9 * max(1.0, abs(above.bottom)):
-            errors.append(SceneError(f"{t.key_path('layers')}[{j}].top", t.data["layers"][j]["top"],
-                                     f"layers must not overlap: {t.key_path('layers')}[{i}] spans "
-                                     f"{above.top:.6g}..{above.bottom:.6g} m, {t.key_path('layers')}[{j}] "
-                                     f"{below.top:.6g}..{below.bottom:.6g} m"))
-    raise_all(errors)
+    background = Rock(**rock) if t.has("min_stress") else None
+    raise_all(_tiling(t, layers, background))
     t.finish()
     return Rock(layers=tuple(layer for _, layer in layers), **rock)
 
 
+def _tiling(t: Table, layers: list[tuple[int, Layer]], background: Rock | None) -> list[SceneError]:
+    """The layers must tile the span from the shallowest top to the deepest bottom: an overlap is an error; a gap
+    is an error too unless the scene gives ``[rock] min_stress`` (``background``): then the gap takes the rock's
+    values, with a warning. Depths are shown in the scene's units (a boundary within 1e-9 relative is shared)."""
+    system = scene_system()
+    path = t.key_path("layers")
+
+    def depth(z: float) -> str:
+        return display_text(z, "depth", system, digits=6)
+
+    errors: list[SceneError] = []
+    ordered = sorted(layers, key=lambda item: item[1].top)
+    for (i, above), (j, below) in zip(ordered, ordered[1:]):
+        tolerance = 1e-9 * max(1.0, abs(above.bottom))
+        top = t.data["layers"][j]["top"]
+        if below.top < above.bottom - tolerance:
+            errors.append(SceneError(f"{path}[{j}].top", top, f"layers must not overlap: {path}[{i}] spans "
+                                     f"{depth(above.top)} to {depth(above.bottom)}, {path}[{j}] spans "
+                                     f"{depth(below.top)} to {depth(below.bottom)}"))
+        elif below.top > above.bottom + tolerance:
+            gap = (f"a gap of {display_text(below.top - above.bottom, 'length', system, digits=6)} between "
+                   f"{path}[{i}] (bottom {depth(above.bottom)}) and {path}[{j}] (top {depth(below.top)})")
+            if background is not None:
+                sigma = float(background.min_stress_at(np.array(above.bottom)))
+                warn(f"{path}[{j}].top {depth(below.top)}: {gap} takes [rock]'s values there (min_stress "
+                     f"{display_text(sigma, 'pressure', system)} at {depth(above.bottom)})")
+            else:
+                errors.append(SceneError(f"{path}[{j}].top", top, f"layers must tile their span: {gap}; close "
+                                         "it, add a layer there, or give [rock] min_stress (gaps then take the "
+                                         "rock's values)"))
+    return errors
+
+
 def _parse_layer(lt: Table) -> Layer:
+    top, bottom = lt.quantity("top", "length"), lt.quantity("bottom", "length")
+    min_stress, gradient = lt.stress("min_stress", None)
     layer = Layer(
-        top=lt.quantity("top", "length"),
-        bottom=lt.quantity("bottom", "length"),
-        min_stress=lt.quantity("min_stress", "pressure", None),
+        top=top,
+        bottom=bottom,
+        min_stress=min_stress,
         toughness=lt.quantity("toughness", "toughness", None, minimum=0.0),
         leakoff_coefficient=lt.quantity("leakoff_coefficient", "leakoff", None, minimum=0.0),
         pore_pressure=lt.quantity("pore_pressure", "pressure", None),
+        min_stress_gradient=gradient,
     )
     if layer.bottom <= layer.top:
         raise SceneError(lt.key_path("bottom"), lt.data["bottom"],
@@ -576,10 +634,16 @@ def _stage_end(st: Table, key: str, start: float, rate: float, mean_fraction: fl
     return until
 
 
+#: Proppant concentrations above this [ppa] are warned about: treatments pump up to about 8-12 ppa, so a larger
+#: value is likely a typo (the error bound is the slurry volume fraction 0.6).
+HIGH_CONCENTRATION_PPA = 12.0
+
+
 def _stage_fractions(st: Table, density: float | None) -> tuple[float, float]:
     """Start/end slurry volume fraction of a stage from volume_fraction or concentration (ppa).
 
-    A concentration c [kg per m^3 of clean fluid] gives the slurry fraction (c/rho_p) / (1 + c/rho_p).
+    A concentration c [kg per m^3 of clean fluid] gives the slurry fraction (c/rho_p) / (1 + c/rho_p): an error
+    above 0.6, a warning for c above :data:`HIGH_CONCENTRATION_PPA`.
     """
     if st.has("volume_fraction") and st.has("concentration"):
         raise SceneError(st.key_path("concentration"), st.data["concentration"],
@@ -591,10 +655,16 @@ def _stage_fractions(st: Table, density: float | None) -> tuple[float, float]:
         if density is None:
             return 0.0, 0.0
         fractions = [(c / density) / (1.0 + c / density) for c in (c0, c1)]
-        for key, f in zip(("concentration", "end_concentration"), fractions):
+        high = convert(HIGH_CONCENTRATION_PPA, "ppa", "kg/m**3")
+        for key, c, f in zip(("concentration", "end_concentration"), (c0, c1), fractions):
             if f > bounds["maximum"]:
                 raise SceneError(st.key_path(key), st.data.get(key), "this loading gives a slurry "
                                  f"volume fraction {f:.3f}; allowed: <= 0.6")
+            if c > high and st.has(key):
+                system = scene_system()
+                warn(f"scene key '{st.key_path(key)}': {st.data[key]!r} (slurry volume fraction {f:.3f}) is more "
+                     f"than {display_text(high, 'concentration', system)}, about the most a treatment pumps: check "
+                     "the value")
         return fractions[0], fractions[1]
     f0 = st.number("volume_fraction", **bounds)
     f1 = st.number("end_volume_fraction", f0, **bounds)

@@ -16,8 +16,9 @@ Warnings (the scene is valid, but likely not what was meant):
 * ``run.end_time`` ends before the pump schedule (its last stages are not pumped) or after it (the rest is shut in;
   a last stage at rate 0 ending at end_time says so and silences the warning);
 * a pad stage (no proppant) at rate 0 before the pumping is done;
-* a layer boundary within 1 % of a cell's size of a row of cell centres (rows lie at the injection depth + k dz,
-  dz in use): that row's properties then hang on round-off;
+* a layer boundary the fracture grid cannot put on a cell face (:func:`hfgpu.fracture.mesh.fit_layers`: the faces
+  are placed on the boundary nearest the injection depth, dz in use; a boundary a whole number of cells from it is
+  on a face too): one warning per such boundary, naming the cell height that puts every boundary on a face;
 * fewer than :data:`MIN_CELLS_ACROSS` cells (dz in use) across a layer the fracture enters: the layer at the
   injection depth and the layers just above and below it (the outermost layers, which extend to +-infinity, are
   not counted).
@@ -36,8 +37,6 @@ from .units import display_unit, format_number, in_display_units
 
 #: Cells (dz in use) a layer the fracture enters should span at least.
 MIN_CELLS_ACROSS = 3
-#: A boundary closer than this fraction of dz to a row of cell centres lies "through" it.
-CENTRE_TOLERANCE = 0.01
 
 
 def validate(scene_or_path: Scene | str | Path) -> Scene:
@@ -130,15 +129,7 @@ def _layers(scene: Scene, system: str) -> list[str]:
         found.append(f"injection.depth {_length(depth, system, 'depth')} lies {side} every layer of [[rock.layers]] "
                      f"({_length(tops[0], system, 'depth')} to {_length(bottoms[-1], system, 'depth')}): the "
                      f"{'top' if side == 'above' else 'bottom'} layer's properties are extended to it")
-    for k, (i, layer) in enumerate(ordered):
-        for key, boundary, outer in (("top", layer.top, k == 0), ("bottom", layer.bottom, k == len(ordered) - 1)):
-            if outer:
-                continue
-            rows = (boundary - depth) / dz
-            if abs(rows - round(rows)) < CENTRE_TOLERANCE:
-                found.append(f"rock.layers[{i}].{key} {_length(boundary, system, 'depth')} runs through a row of cell "
-                             f"centres (cells {_length(dz, system)} tall, a row at injection.depth "
-                             f"{_length(depth, system, 'depth')}): move it or the injection depth by half a cell")
+    found += _off_face(scene, system, ordered)
     at = next((k for k, (_, layer) in enumerate(ordered) if layer.top <= depth < layer.bottom), None)
     entered = [] if at is None else [k for k in (at - 1, at, at + 1) if 0 < k < len(ordered) - 1]
     for k in entered:
@@ -148,6 +139,34 @@ def _layers(scene: Scene, system: str) -> list[str]:
             found.append(f"rock.layers[{i}] ({_length(layer.bottom - layer.top, system)} thick) is "
                          f"{format_number(cells, 2)} cells of {_length(dz, system)} across, fewer than "
                          f"{MIN_CELLS_ACROSS}: the fracture enters it; use finer cells")
+    return found
+
+
+def _off_face(scene: Scene, system: str, ordered: list) -> list[str]:
+    """One warning per layer boundary the fracture grid cannot put on a cell face (fit_layers), with the cell
+    height that puts every boundary on one."""
+    from .fracture.mesh import HONOURING_RANGE, fit_layers, layer_boundaries  # a proppant-only run needs none
+
+    depth, dz, refinement = scene.injection.depth, scene.mesh.dz, scene.mesh.refinement
+    fit = fit_layers(depth, dz, layer_boundaries(scene.rock.layers))
+    if fit.honouring is None:
+        remedy = (f"no cell height from {_length(dz / HONOURING_RANGE, system)} to {_length(dz, system)} puts every "
+                  "layer boundary on a face")
+    else:
+        setting = _length(fit.honouring * refinement, system)
+        remedy = (f"cells {_length(fit.honouring, system)} tall ([mesh] cell_size height {setting}"
+                  f"{'' if refinement == 1.0 else f' / refinement {refinement:g}'}) put every layer boundary on a "
+                  "face")
+    found = []
+    for boundary in fit.off_face:
+        keys = [f"rock.layers[{i}].{key}" for k, (i, layer) in enumerate(ordered)
+                for key, value, outer in (("top", layer.top, k == 0), ("bottom", layer.bottom, k == len(ordered) - 1))
+                if value == boundary and not outer]
+        found.append(f"{' = '.join(keys)} {_length(boundary, system, 'depth')} is not on a cell face: the grid's "
+                     f"faces (cells {_length(dz, system)} tall) are placed on the boundary at "
+                     f"{_length(fit.anchor, system, 'depth')}, the nearest to injection.depth "
+                     f"{_length(depth, system, 'depth')}, so a row straddles {_length(boundary, system, 'depth')} "
+                     f"with the properties at its centre; {remedy}")
     return found
 
 

@@ -6,8 +6,11 @@ error too (a typo must not be silently ignored), with the closest allowed key ("
 that is missing names a close unknown key of the same table as the likely typo.
 
 Bare numbers: a plain number for a key that takes a unit is read as SI; unless it is 0 it adds a warning (one
-line). Warnings are collected, and the did-you-mean hints given, while :func:`collecting_warnings` is active (as in
-:func:`hfgpu.scene.parse_scene`; other files read with :class:`Table`, such as sweep files, keep the plain messages).
+line). In a scene whose unit system is field (``[output] units``, else the majority of its values,
+:func:`hfgpu.units.majority_system`) such a number is an error instead, unless its kind is time (seconds in both
+systems). Warnings are collected, the did-you-mean hints given and the scene's system known while
+:func:`collecting_warnings` is active (as in :func:`hfgpu.scene.parse_scene`; other files read with :class:`Table`,
+such as sweep files, keep the plain messages and the SI rule).
 """
 
 from __future__ import annotations
@@ -18,9 +21,10 @@ import difflib
 from typing import Any, Iterable, Iterator
 
 from .errors import MISSING, SceneError
-from .units import to_si
+from .units import FIELD_UNITS, SI_UNITS, has_dimension_of, to_si
 
 _WARNINGS: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar("scene_warnings", default=None)
+_SYSTEM: contextvars.ContextVar[str] = contextvars.ContextVar("scene_system", default="SI")
 
 
 class SceneErrors(SceneError):
@@ -44,15 +48,21 @@ def raise_all(errors: list[SceneError]) -> None:
 
 
 @contextlib.contextmanager
-def collecting_warnings() -> Iterator[list[str]]:
-    """Collect the warnings of the tables read inside the block into the list it yields, and give did-you-mean
-    hints in the errors."""
+def collecting_warnings(system: str = "SI") -> Iterator[list[str]]:
+    """Collect the warnings of the tables read inside the block into the list it yields, give did-you-mean
+    hints in the errors, and judge bare numbers as the scene's unit ``system`` ("SI" or "field") asks."""
     found: list[str] = []
-    token = _WARNINGS.set(found)
+    token, system_token = _WARNINGS.set(found), _SYSTEM.set(system)
     try:
         yield found
     finally:
         _WARNINGS.reset(token)
+        _SYSTEM.reset(system_token)
+
+
+def scene_system() -> str:
+    """The unit system of the scene being read ("SI" outside :func:`collecting_warnings`)."""
+    return _SYSTEM.get()
 
 
 def warn(message: str) -> None:
@@ -106,14 +116,24 @@ class Table:
             return None  # type: ignore[return-value]
         number = to_si(value, kind, self.key_path(key))
         if kind != "dimensionless" and number != 0.0 and key in self.data and not isinstance(value, str):
-            from .units import SI_UNITS
-
-            unit = SI_UNITS[kind]
-            warn(f"scene key '{self.key_path(key)}': bare number {value!r} read as {value!r} {unit} (SI); write "
-                 f"the unit, e.g. \"{value} {unit}\"")
+            _bare_number(self.key_path(key), value, kind)
         check_bounds(self.key_path(key), value, number, kind, minimum, maximum,
                      exclusive_minimum, exclusive_maximum)
         return number
+
+    def stress(self, key: str, default: Any = MISSING) -> tuple[float | None, float]:
+        """(sigma_c [Pa], gradient [Pa/m]) of a stress that is either a pressure ("6000 psi": (sigma, 0)) or a
+        gradient in depth ("0.75 psi/ft": (0, gradient >= 0)), so that sigma(z) = sigma_c + gradient z."""
+        value = self.raw(key, default)
+        if has_dimension_of(value, "stress_gradient"):
+            return 0.0, self.quantity(key, "stress_gradient", minimum=0.0)
+        try:
+            return self.quantity(key, "pressure", default), 0.0
+        except SceneError as exc:
+            if exc.path != self.key_path(key) or not exc.allowed.startswith("expected"):
+                raise
+            raise SceneError(exc.path, exc.value, exc.allowed.replace(
+                "expected a pressure", 'expected a stress gradient (e.g. "0.75 psi/ft") or a pressure', 1)) from None
 
     def number(self, key: str, default: Any = MISSING, **bounds: Any) -> float:
         return self.quantity(key, "dimensionless", default, **bounds)
@@ -171,11 +191,21 @@ class Table:
         raise_all(errors)
 
 
+def _bare_number(path: str, value: float, kind: str) -> None:
+    """A plain non-zero number for a key of ``kind`` (not dimensionless): an error in a field scene (except a
+    time), else a warning; both name the unit to write."""
+    unit = SI_UNITS[kind]
+    field_unit = FIELD_UNITS.get(kind)
+    if scene_system() == "field" and field_unit is not None:
+        raise SceneError(path, value, f"a bare number is not read in a scene written in field units: write its "
+                                      f"unit, e.g. \"{value} {field_unit}\" (or \"{value} {unit}\" if SI is meant)")
+    warn(f"scene key '{path}': bare number {value!r} read as {value!r} {unit} (SI); write the unit, e.g. "
+         f"\"{value} {unit}\"")
+
+
 def check_bounds(path: str, raw: Any, number: float, kind: str, minimum: float | None,
                  maximum: float | None, exclusive_minimum: bool, exclusive_maximum: bool) -> None:
     """Raise a SceneError when ``number`` lies outside [minimum, maximum] (SI)."""
-    from .units import SI_UNITS
-
     unit = SI_UNITS.get(kind, "")
     low_bad = minimum is not None and (number <= minimum if exclusive_minimum else number < minimum)
     high_bad = maximum is not None and (number >= maximum if exclusive_maximum else number > maximum)

@@ -2,8 +2,9 @@
 
 Every value is either a plain number, taken as SI, or a string with units ("40 GPa", "20 bbl/min",
 "2 MPa*m**0.5"). Oilfield units are defined here once: ``bbl`` is the 42-gallon oil barrel (pint's own
-``bbl`` is the 31.5-gallon fluid barrel), ``gpm`` is US gallons per minute, ``ppa``/``ppg`` are pounds of
-proppant added per US gallon of clean fluid, ``md`` is the millidarcy (conductivities in "md*ft").
+``bbl`` is the 31.5-gallon fluid barrel), ``bpm`` is bbl per minute, ``gpm`` is US gallons per minute, ``cp`` is
+the centipoise (as ``cP``; pint's own ``cp`` is the cup), ``ppa``/``ppg`` are pounds of proppant added per US
+gallon of clean fluid, ``md`` is the millidarcy (conductivities in "md*ft").
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ SI_UNITS = {
     "permeability": "m**2",
     "conductivity": "m**3",
     "areal_density": "kg/m**2",
+    "stress_gradient": "Pa/m",
     "dimensionless": "",
 }
 
@@ -42,9 +44,9 @@ _EXAMPLES = {
     "pressure": '"60 MPa", "9000 psi"',
     "toughness": '"1 MPa*m**0.5"',
     "leakoff": '"2e-7 m/s**0.5"',
-    "viscosity": '"0.08 Pa*s", "1 cP"',
+    "viscosity": '"0.08 Pa*s", "20 cP"',
     "density": '"2650 kg/m**3"',
-    "rate": '"0.053 m**3/s", "20 bbl/min", "6 gpm"',
+    "rate": '"0.053 m**3/s", "20 bbl/min", "5 bpm", "6 gpm"',
     "volume": '"100 m**3", "500 bbl"',
     "concentration": '"2 ppa", "240 kg/m**3"',
     "velocity": '"0.1 m/s"',
@@ -52,7 +54,17 @@ _EXAMPLES = {
     "permeability": '"0.1 md", "180 darcy"',
     "conductivity": '"4000 md*ft", "1.2 darcy*m"',
     "areal_density": '"2 lb/ft**2", "9.76 kg/m**2"',
+    "stress_gradient": '"0.75 psi/ft", "17 kPa/m"',
     "dimensionless": "a plain number",
+}
+
+#: The field unit a bare number of each kind would most likely have been meant in (the unit a field-units scene is
+#: told to write, hfgpu.scene_reader); time is missing: seconds are read the same in both systems.
+FIELD_UNITS = {
+    "length": "ft", "pressure": "psi", "toughness": "psi*in**0.5", "leakoff": "ft/min**0.5", "viscosity": "cP",
+    "density": "lb/gal", "rate": "bbl/min", "volume": "bbl", "concentration": "ppa", "velocity": "ft/s",
+    "acceleration": "ft/s**2", "permeability": "md", "conductivity": "md*ft", "areal_density": "lb/ft**2",
+    "stress_gradient": "psi/ft",
 }
 
 
@@ -68,7 +80,9 @@ def registry() -> pint.UnitRegistry:
         except OSError:
             ureg = pint.UnitRegistry(on_redefinition="warn")
         ureg.define("bbl = 42 * gallon = oilfield_barrel")
+        ureg.define("bpm = bbl / minute")
         ureg.define("gpm = gallon / minute")
+        ureg.define("cp = centipoise")  # pint would read "cp" as the cup, a volume
         ureg.define("ppa = pound / gallon")
         ureg.define("ppg = pound / gallon")
         ureg.define("md = millidarcy")  # pint would read "md" as a milli-day
@@ -119,6 +133,17 @@ def _check_quantity_text(value: str, path: str, allowed: str) -> None:
         raise SceneError(path, value, f"{allowed}; write one number followed by its units")
 
 
+def has_dimension_of(value: object, kind: str) -> bool:
+    """Whether ``value`` is a quantity text ("0.75 psi/ft") whose dimension is that of ``kind``'s SI unit."""
+    if not isinstance(value, str):
+        return False
+    ureg = registry()
+    try:
+        return ureg.Quantity(value.strip()).dimensionality == ureg.Quantity(1.0, SI_UNITS[kind]).dimensionality
+    except Exception:  # pint raises several unrelated types on bad text: to_si reports it
+        return False
+
+
 def convert(value: float, from_unit: str, to_unit: str) -> float:
     """Convert a number between units (for reports and field-unit display)."""
     return float(registry().Quantity(value, from_unit).to(to_unit).magnitude)
@@ -132,7 +157,7 @@ SYSTEMS = ("SI", "field")
 #: viscosity unit (m, mm, Pa, MPa, kg, L, Pa*s, mPa*s, ...) marks it SI; time units (s, min, h), darcy and md
 #: mark neither.
 FIELD_WORDS = frozenset({"ft", "foot", "feet", "in", "inch", "inches", "yd", "mi", "mile", "psi", "kpsi", "bbl",
-                         "gal", "gallon", "gallons", "gpm", "ppa", "ppg", "lb", "lbs", "pound", "pounds", "cp",
+                         "gal", "gallon", "gallons", "gpm", "bpm", "ppa", "ppg", "lb", "lbs", "pound", "pounds", "cp",
                          "centipoise", "degF", "lbf", "ton"})
 NEUTRAL_WORDS = frozenset({"s", "sec", "second", "seconds", "min", "minute", "minutes", "h", "hr", "hour", "hours",
                            "day", "days", "md", "darcy", "millidarcy", "percent"})
@@ -148,7 +173,7 @@ def system_of(text: str) -> str | None:
     words = [w for w in _WORD.findall(text[match.end():]) if w not in ("e", "E")]
     if not words:
         return None
-    if any(w in FIELD_WORDS or w.lower() in ("cp", "psi", "bbl", "ppa", "ppg") for w in words):
+    if any(w in FIELD_WORDS or w.lower() in ("cp", "psi", "bbl", "bpm", "ppa", "ppg") for w in words):
         return "field"
     if all(w in NEUTRAL_WORDS for w in words):
         return None
@@ -208,6 +233,11 @@ def stored_unit(kind: str) -> str:
 
 _DISPLAY_SI = {"depth": "m", "width": "m", "area": "m**2", "solid_volume": "m**3", "mass": "kg", "radius": "m",
                "speed": "m/s"}
+
+
+def display_text(value: float, kind: str, system: str, digits: int = 4) -> str:
+    """An SI ``value`` of display ``kind`` as text in ``system``'s display unit: "8 025 ft", "2 446 m"."""
+    return f"{format_number(in_display_units(value, kind, system), digits)} {display_unit(kind, system)}"
 
 
 def format_number(value: float, digits: int = 4) -> str:

@@ -13,7 +13,8 @@ The powers theta_f^-2.65, theta_f^-1.78 and Re^0.687, Re^(2/3) are exp(a log b) 
 shared.
 
 Fast paths (per-cell bits of stencil.cell_flags): a parcel whose cell and its 8 neighbours are open and inside
-the grid (INTERIOR) uses plain bilinear weights without mask reads (gather, scatter, exchange); one whose 3 x 3
+the grid (INTERIOR) uses plain bilinear weights without mask reads in the gather (scatter and exchange weight
+each node by its width, stencil.volume_weights); one whose 3 x 3
 cells are also below close packing (QUIET) and that stays in its cell skips the wall checks of its move; one in
 a LOOSE cell is not on a bed. Each gives what the general path gives (up to round-off: the renormalisation by
 a sum of weights that is 1 up to an ulp).
@@ -30,7 +31,7 @@ from hfgpu.kernels import elementary
 from hfgpu.kernels.layout import (
     PARAM_COUNT,
     BRIDGED, CELL, DAMPING, DENSITY, DRAG, F_DP, F_DTAU, F_MASK, F_VELOCITY, GONE, LAG_X, LAG_Z, MEAN_U,
-    MEAN_V, OUTLET, P_BED_FRICTION, P_BRIDGING, P_DAMPING_THRESHOLD, P_DRAG_ITERATIONS, P_DRAG_LAW, P_DX, P_DZ,
+    F_WIDTH, MEAN_V, OUTLET, P_BED_FRICTION, P_BRIDGING, P_DAMPING_THRESHOLD, P_DRAG_ITERATIONS, P_DRAG_LAW, P_DX, P_DZ,
     P_EPSILON, P_FRICTION_FRACTION, P_GRAVITY, P_MU, P_PACKING_RESTITUTION, P_RE_COEFFICIENT, P_RHO_F, P_SHIELDS,
     P_THETA_CP, P_WALL_LAW, P_X0, P_Z0, PARTICLES, RADIUS, S_DAMPING, S_DPDX, S_DPDZ, S_DTDX, S_DTDZ, S_MEAN_U,
     S_MEAN_V, S_THETA, S_UF, S_VF, S_WIDTH, SEEN, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW, ST_SPEED,
@@ -38,8 +39,8 @@ from hfgpu.kernels.layout import (
 from hfgpu.kernels.momentum import wall_friction_factor
 from hfgpu.kernels.runtime import ti
 from hfgpu.kernels.stencil import (
-    INTERIOR, LOOSE, NO_RUN, QUIET, bilinear, block_range, blocked, closed, deposit_weights, flush, owner,
-    owner_flags, run_sum, sample)
+    INTERIOR, LOOSE, NO_RUN, QUIET, bilinear, block_range, blocked, closed, flush, owner,
+    owner_flags, run_sum, sample, volume_weights)
 
 PI = 3.141592653589793
 #: A deposit pass with private copies runs ``blocks`` tasks; its loop counts blocks x SPREAD iterations, one in
@@ -108,7 +109,7 @@ def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template()
             for p in range(start, end):
                 if S[STATE, p] != GONE:
                     sx, sz = cell_coordinates(P, p, PR)
-                    k0, i0, w = deposit_weights(sx, sz, 0.0, 0.0, C, CELL, owner_flags(sx, sz, FLAGS))
+                    k0, i0, w = volume_weights(sx, sz, 0.0, 0.0, C, CELL, WIDTH)
                     acc, kb, ib = run_sum(CD, copy, k0, i0, kb, ib, acc, 7, private)
                     r = P[RADIUS, p]
                     n_p = P[PARTICLES, p]
@@ -310,17 +311,18 @@ def move(p: ti.i32, sx: ti.f64, sz: ti.f64, flag: ti.i32, P: ti.template(), dt: 
     a QUIET cell (``flag``, stencil_flags) that stays in it is not stopped and skips the checks."""
     theta_cp = PR[P_THETA_CP]
     dense = PR[P_FRICTION_FRACTION]
+    gap = PR[P_BRIDGING] * 2.0 * P[RADIUS, p]
     xn = P[X, p] + dt * P[U, p]
     sxn = (xn - PR[P_X0]) / PR[P_DX]
     zn = P[Z, p] + dt * P[V, p]
     szn = (zn - PR[P_Z0]) / PR[P_DZ]
     stays = ti.floor(sxn + 0.5) == ti.floor(sx + 0.5) and ti.floor(szn + 0.5) == ti.floor(sz + 0.5)
     if not (stays and flag & QUIET):
-        if blocked(sx, sz, sxn, sz, C, theta_cp, dense):
+        if blocked(sx, sz, sxn, sz, C, theta_cp, dense, gap):
             xn = P[X, p]
             sxn = sx
             P[U, p] = 0.0
-        if blocked(sxn, sz, sxn, szn, C, theta_cp, dense):
+        if blocked(sxn, sz, sxn, szn, C, theta_cp, dense, gap):
             zn = P[Z, p]
             P[V, p] = 0.0
     P[X, p] = xn
@@ -421,8 +423,8 @@ def exchange_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i3
                 if S[STATE, p] != GONE:
                     sx, sz = cell_coordinates(P, p, PR)
                     flag = owner_flags(sx, sz, FLAGS)
-                    k0, i0, w = deposit_weights(sx, sz, 0.5, 0.0, XF, F_MASK, flag)
-                    k1, i1, w1 = deposit_weights(sx, sz, 0.0, 0.5, ZF, F_MASK, flag)
+                    k0, i0, w = volume_weights(sx, sz, 0.5, 0.0, XF, F_MASK, F_WIDTH)
+                    k1, i1, w1 = volume_weights(sx, sz, 0.0, 0.5, ZF, F_MASK, F_WIDTH)
                     vol = solid_volume(P, p)
                     rate = vol * P[DENSITY, p] * W[DRAG, p]
                     fx = ti.Vector([rate * (W[S_UF, p] - P[U, p]), rate * W[LAG_X, p]], dt=ti.f64)

@@ -86,17 +86,24 @@ def cell_flags(k: ti.i32, i: ti.i32, cells: ti.template(), theta_cp: ti.f64, den
 
 
 @ti.func
-def deposit_weights(sx: ti.f64, sz: ti.f64, ox: ti.template(), oz: ti.template(), grid: ti.template(),
-                    mask: ti.template(), flag: ti.i32):
-    """bilinear at (sx + ox, sz + oz) onto channel ``mask`` of ``grid`` for a parcel at cell coordinates
-    (sx, sz) whose cell has the stencil_flags ``flag`` (owner_flags): plain weights where it is INTERIOR."""
-    k0 = ti.cast(0, ti.i32)
-    i0 = ti.cast(0, ti.i32)
-    w = ti.Vector.zero(ti.f64, 4)
-    if flag & INTERIOR:
-        k0, i0, w = bilinear(sx + ox, sz + oz, grid, mask, True)
+def volume_weights(sx: ti.f64, sz: ti.f64, ox: ti.template(), oz: ti.template(), grid: ti.template(),
+                   mask: ti.template(), width: ti.template()):
+    """Deposit weights (Eq. 38-39) at (sx + ox, sz + oz): the bilinear weights onto the active nodes (channel
+    ``mask`` of ``grid``) times each node's width (channel ``width``), renormalised, I_k w_k / sum_j I_j w_j
+    (interpolation.deposit_masks). A parcel's share of node k divided by the node's volume dx dz w_k is then
+    V I_k / (dx dz sum_j I_j w_j), its bilinear share over the mean width of its stencil, so a narrow cell beside
+    a loaded wide one (a fracture's tip, a cell that just opened) is not given w_wide / w_k times its
+    neighbours' theta_p. On a uniform width these are the plain bilinear weights."""
+    k0, i0, w = bilinear(sx + ox, sz + oz, grid, mask, False)
+    for a in ti.static(range(2)):
+        for b in ti.static(range(2)):
+            if w[2 * a + b] > 0.0:
+                w[2 * a + b] = w[2 * a + b] * ti.max(grid[width, k0 + a, i0 + b], 0.0)
+    total = w[0] + w[1] + w[2] + w[3]
+    if total > 0.0:
+        w = w / total
     else:
-        k0, i0, w = bilinear(sx + ox, sz + oz, grid, mask, False)
+        w = ti.Vector([0.0, 0.0, 0.0, 0.0], dt=ti.f64)
     return k0, i0, w
 
 
@@ -137,14 +144,21 @@ def closed(k: ti.i32, i: ti.i32, cells: ti.template()) -> ti.i32:
 
 @ti.func
 def blocked(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.template(), theta_cp: ti.f64,
-            dense: ti.f64) -> ti.i32:
-    """The move (sx, sz) -> (sxn, szn) (cell coordinates) leaves the grid, enters a closed cell, raises the
-    parcel's bilinear weight on a cell with theta_p >= theta_cp, or heads for a wall from a cell with theta_p >=
-    dense (friction_volume_fraction; particle_ops_numpy._blocked)."""
+            dense: ti.f64, gap: ti.f64) -> ti.i32:
+    """The move (sx, sz) -> (sxn, szn) (cell coordinates) leaves the grid, enters a closed cell, enters another
+    cell narrower than ``gap`` (the parcel's bridging width, bridging_factor x 2 r), raises the parcel's bilinear
+    weight on a cell with theta_p >= theta_cp, or heads for a wall from a cell with theta_p >= dense
+    (friction_volume_fraction; particle_ops_numpy._blocked)."""
     out = 1
-    if owner_width(sxn, szn, cells) > 0.0:
+    width = owner_width(sxn, szn, cells)
+    if width > 0.0:
         out = 0
-        if packed_near(sxn, szn, cells, theta_cp):
+        if width < gap:
+            k0, i0 = owner(sx, sz)
+            k1, i1 = owner(sxn, szn)
+            if k0 != k1 or i0 != i1:
+                out = 1
+        if out == 0 and packed_near(sxn, szn, cells, theta_cp):
             out = packed_gain(sx, sz, sxn, szn, cells, theta_cp)
         if out == 0:
             out = toward_wall_dense(sx, sz, sxn, szn, cells, dense)

@@ -104,11 +104,22 @@ def test_balanced_is_the_old_defaults():
 
 @pytest.mark.parametrize("preset", ["fast", "accurate"])
 def test_preset_supplies_every_default(preset):
+    """Every knob from the preset, except what a coupled scene computes from its schedule (hfgpu.defaults), scaled
+    by the preset: fracture_every = s min(90 s / 60, 30 s / 10), dt_max = min(s 60 s / 100, fracture_every / 2)."""
     scene = load_scene(scene_text(COUPLED, preset))
     values = knob_values(scene)
-    assert set(values) == set(OLD_DEFAULTS)
-    assert values == {(s, k): getattr(PRESETS[preset], k) for s, k in values}
-    assert all(origin == f"preset {preset}" for _, _, origin in effective_knobs(scene))
+    derived = {tuple(d.key.split(".")) for d in scene.derived}
+    assert derived == {("coupling", "fracture_every"), ("mppic", "dt_max"), ("mppic", "max_parcels")}
+    assert set(values) == set(OLD_DEFAULTS) | derived
+    given = {key: value for key, value in values.items() if key not in derived}
+    assert given == {(s, k): getattr(PRESETS[preset], k) for s, k in given}
+    origins = {tuple(path.split(".")): origin for path, _, origin in effective_knobs(scene)}
+    assert all(origins[key] == f"preset {preset}" for key in given)
+    assert all(origins[key].startswith("from the scene: ") for key in derived)
+    scale = PRESETS[preset].time_scale
+    assert values[("coupling", "fracture_every")] == pytest.approx(1.5 * scale)
+    assert values[("mppic", "dt_max")] == pytest.approx(min(0.6 * scale, 0.75 * scale))
+    assert values[("mppic", "max_parcels")] == PRESETS[preset].parcel_budget
     assert scene.mesh.dx == 5.0 / PRESETS[preset].refinement
 
 

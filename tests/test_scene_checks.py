@@ -158,11 +158,11 @@ def test_injection_depth_outside_the_layer_table(depth, message):
     assert warnings_of(FIELD.replace('depth = "10010 ft"', f"depth = {depth}")) == [message]
 
 
-def test_bare_number_for_a_dimensional_key_is_read_as_si_and_warned():
-    found = warnings_of(FIELD.replace('depth = "10010 ft"', "depth = 3051"))
-    assert found == ["scene key 'injection.depth': bare number 3051 read as 3051 m (SI); write the unit, "
-                     'e.g. "3051 m"']
-    assert load_scene(FIELD.replace('depth = "10010 ft"', "depth = 3051")).injection.depth == 3051.0
+def test_bare_number_for_a_dimensional_key_is_read_as_si_and_warned_in_an_si_scene():
+    si = FIELD.replace('depth = "10010 ft"', "depth = 3051") + '[output]\nunits = "SI"\n'
+    assert warnings_of(si) == ["scene key 'injection.depth': bare number 3051 read as 3051 m (SI); write the unit, "
+                               'e.g. "3051 m"']
+    assert load_scene(si).injection.depth == 3051.0
     # a bare 0 is the same in every unit, and a dimensionless key takes a bare number: no warning
     assert warnings_of(FIELD.replace('min_stress = "6000 psi"\n[[', 'min_stress = 0\n[[')) == []
 
@@ -191,17 +191,19 @@ def test_zero_rate_pad():
                                  "before pumping goes on; give its rate"]
 
 
-def test_layer_boundary_through_cell_centres():
-    text = FIELD.replace('depth = "10010 ft"', 'depth = "10000 ft"')   # rows at 10000 ft + k 20 ft: 9960, 10040
+def test_boundaries_a_whole_number_of_cells_apart_lie_on_faces():
+    # the perforation on a face (the grid's rows are placed on the boundaries): 9960 and 10040 ft both on faces
+    assert warnings_of(FIELD.replace('depth = "10010 ft"', 'depth = "10000 ft"')) == []
+
+
+def test_a_boundary_off_every_face_is_named_once_with_a_cell_height_that_honours_it():
+    # a 70 ft pay (3.5 cells): faces on 10030 ft, the boundary nearest the perforation; 9960 ft cannot be on one
+    text = FIELD.replace('bottom = "10040 ft"', 'bottom = "10030 ft"').replace('top = "10040 ft"', 'top = "10030 ft"')
     assert warnings_of(text) == [
-        "rock.layers[0].bottom 9 960 ft runs through a row of cell centres (cells 20 ft tall, a row at "
-        "injection.depth 10 000 ft): move it or the injection depth by half a cell",
-        "rock.layers[1].top 9 960 ft runs through a row of cell centres (cells 20 ft tall, a row at "
-        "injection.depth 10 000 ft): move it or the injection depth by half a cell",
-        "rock.layers[1].bottom 10 040 ft runs through a row of cell centres (cells 20 ft tall, a row at "
-        "injection.depth 10 000 ft): move it or the injection depth by half a cell",
-        "rock.layers[2].top 10 040 ft runs through a row of cell centres (cells 20 ft tall, a row at "
-        "injection.depth 10 000 ft): move it or the injection depth by half a cell"]
+        "rock.layers[0].bottom = rock.layers[1].top 9 960 ft is not on a cell face: the grid's faces (cells 20 ft "
+        "tall) are placed on the boundary at 10 030 ft, the nearest to injection.depth 10 010 ft, so a row straddles "
+        "9 960 ft with the properties at its centre; cells 17.5 ft tall ([mesh] cell_size height 17.5 ft) put every "
+        "layer boundary on a face"]
 
 
 def test_too_few_cells_across_a_layer_the_fracture_enters():
@@ -252,11 +254,12 @@ def test_all_errors_of_a_scene_in_one_report(tmp_path, capsys):
         "top ('10040 ft'); depth is positive downward"]
 
 
-def test_overlapping_layers_are_named_with_rounded_depths():
+def test_overlapping_layers_are_named_in_the_scene_units():
     with pytest.raises(SceneError) as info:
         load_scene(FIELD.replace('top = "10040 ft"', 'top = "10030 ft"'))
     assert str(info.value) == ("scene key 'rock.layers[2].top': got '10030 ft'; layers must not overlap: "
-                               "rock.layers[1] spans 3035.81..3060.19 m, rock.layers[2] 3057.14..3078.48 m")
+                               "rock.layers[1] spans 9 960 ft to 10 040 ft, rock.layers[2] spans 10 030 ft to "
+                               "10 100 ft")
 
 
 def test_a_dependent_section_is_not_reported_twice():

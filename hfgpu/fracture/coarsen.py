@@ -1,7 +1,9 @@
 """Coarsening of the fracture grid: continue on cells ``factor`` times larger (3 x 3 merges by default, or 2x).
 
 When the fracture outgrows the cell budget the engine continues on a grid ``factor`` times coarser, its
-cells centred on the injection (source) cell, so the point source of Eq. 29 stays a cell-centred source.
+cells centred on the injection (source) cell, so the point source of Eq. 29 stays in the coarse cell (0, 0)
+(it sits up to half a fine cell from that cell's centre where the grid is placed on layer boundaries, mesh.py;
+a boundary on a fine face is on a coarse face only where the merge's faces fall on it).
 The map works on the integer-index representation of the active cells as (child, parent, share) triples:
 fine cell ``child`` covers the part ``share`` of its area in coarse cell ``parent``.
 

@@ -13,16 +13,18 @@ closed at w = 0 (contact, newton.solve_step). The injected volume of a step is e
 (Schedule.mean_rate), leak-off is Carter's law integrated exactly (:mod:`leakoff`), and the flux form
 conserves volume, so injected = stored + leaked to the Newton tolerance at every step.
 
-Start. The run starts at t0 from a radial fracture of radius R0 = ``initial_radius_cells`` cells (the
-cells whose centres lie inside it). t0 is the latest of the times at which the four radial vertex solutions
-(M, K, Mt, Kt; REFERENCE.md 1.1) reach R0 with the properties at the injection point -- the slowest
-mechanism controls early growth -- and the cells' opening times follow that vertex's R ~ t^a
+Start. The run starts at t0 from a radial fracture of radius R0 = ``initial_radius_cells`` cells around the
+injection cell's centre (the cells whose centres lie inside it; the grid is placed on the layer boundaries,
+mesh.fit_layers, so that centre is up to half a cell from the injection depth). t0 is the latest of the times
+at which the four radial vertex solutions (M, K, Mt, Kt; REFERENCE.md 1.1) reach R0 with the properties at the
+injection point -- the slowest mechanism controls early growth -- and the cells' opening times follow that
+vertex's R ~ t^a
 (tau = t0 (r / R0)^(1/a)). The cells hold the volume injected by t0 less the Carter volume leaked since
 their opening times (at most 90 % of it), in the shape a uniform net pressure gives (C w = const).
 
 Coarsening. With ``mesh.max_cells_across`` set, the grid is coarsened by ``mesh.coarsening_factor`` (coarsen.py:
-3x3 merges, or PyFrac's 2x remeshing by area overlap; both keep the source at a cell centre) after a step
-whose footprint spans more cells than that along x or z; volume is carried exactly, so the balance holds
+3x3 merges, or PyFrac's 2x remeshing by area overlap; both centre a coarse cell on the injection cell) after a
+step whose footprint spans more cells than that along x or z; volume is carried exactly, so the balance holds
 across the merge, and the active-cell count stays bounded. The merge comes after the step's records and
 snapshots (``coarsen_if_wide``, called by ``simulate`` before it sets the next step), so they are of the fine
 grid's state: a merged state is only the next step's start, its overlap means of widths and tip cells not a
@@ -78,7 +80,7 @@ from .geometry import filled_fraction, footprint
 from .interpolate import StepEnds
 from .leakoff import carter_demand, carter_volume
 from .lubrication import build_faces
-from .mesh import GROW, Grid
+from .mesh import GROW, Grid, injection_cell_centre
 from .newton import Elasticity, StepProblem, solve_step, start_widths
 from .solver_choice import use_dense
 from .tip_cells import fill_and_width, level_set, ribbon_distances
@@ -197,7 +199,7 @@ class _Engine:
         h = max(self.dx, self.dz)
         r0 = numerics.initial_radius_cells * h
         half = int(math.ceil(r0 / min(self.dx, self.dz))) + GROW
-        self.grid = Grid.around_injection(self.dx, self.dz, inj.x, inj.depth, half)
+        self.grid = Grid.around_injection(self.dx, self.dz, *injection_cell_centre(scene), half)
         self._properties()
         k0 = K_PRIME_FACTOR * float(rock.toughness_at(np.array(inj.depth)))
         c0 = 2.0 * float(rock.leakoff_at(np.array(inj.depth)))
@@ -671,6 +673,7 @@ class _Engine:
         with cells where there are none (right after a coarsening)."""
         g, dx, dz = view.grid, view.grid.dx, view.grid.dz
         xo, zo = g.offsets()
+        zo = zo + (g.z_inj - self.scene.injection.depth)   # the injection cell's centre is up to dz/2 off it (mesh.py)
         tips = np.zeros(g.shape, bool)
         if self.num.front_tracking == "subgrid":
             tips, nx, nz = self._tip_normals(view)

@@ -23,8 +23,12 @@ import numpy as np
 #: Checkpoints per run when ``[output] checkpoint_every`` is not given (at most: never more often than
 #: ``output.every``).
 DEFAULT_CHECKPOINTS = 20
-#: Scene fields a resumed run may change (they do not change the results).
-RESUME_MAY_CHANGE = ("output.checkpoint_every",)
+#: Scene fields a resumed run may change: the checkpoint interval (it does not change the results) and the
+#: proppant run's step control and solver numerics (the state carries no trace of them), so that a run stopped by
+#: a collapsing step (hfgpu.proppant.health) continues with, e.g., a smaller [mppic] dt_max or c_max.
+RESUME_MAY_CHANGE = ("output.checkpoint_every",) + tuple(
+    f"proppant.numerics.{name}" for name in ("backend", "arch", "particle_substeps", "c_max", "dt_max",
+                                             "max_step_retries", "simple_tolerance", "simple_max_iterations"))
 
 
 def checkpoint_interval(scene: Any) -> float:

@@ -105,6 +105,8 @@ class MppicNumerics:
     particles_per_parcel: real particles per parcel for every class; when None, it is chosen per class so
     that ``parcels_per_cell`` parcels fill a cell at the class's largest volume fraction (initial or
     injected).
+    max_parcels: when set (and particles_per_parcel is not), the particles per parcel are raised so that the
+    schedule's proppant makes at most this many parcels (a coupled scene's default, hfgpu.defaults).
     particle_substeps: particle sub-steps inside each fluid step (section 4.3).
     c_max: Courant limit of Eq. 42 (< 1); dt_max caps the fluid step [s]; max_step_retries: halvings of a
     step whose Courant number came out above c_max before giving up.
@@ -123,6 +125,7 @@ class MppicNumerics:
     arch: str | None = None
     particles_per_parcel: float | None = None
     parcels_per_cell: int = BALANCED.parcels_per_cell
+    max_parcels: int | None = None
     particle_substeps: int = BALANCED.particle_substeps
     c_max: float = BALANCED.c_max
     dt_max: float = BALANCED.dt_max
@@ -319,6 +322,7 @@ def _parse_mppic(t: Table, preset: Preset = BALANCED) -> tuple[MppicNumerics, An
         arch=arch,
         particles_per_parcel=t.number("particles_per_parcel", None, minimum=1.0),
         parcels_per_cell=t.integer("parcels_per_cell", preset.parcels_per_cell, minimum=1),
+        max_parcels=t.integer("max_parcels", minimum=100) if t.has("max_parcels") else None,
         particle_substeps=t.integer("particle_substeps", preset.particle_substeps, minimum=1, maximum=1000),
         c_max=t.number("c_max", preset.c_max, maximum=1.0, exclusive_maximum=True, **positive),
         dt_max=t.quantity("dt_max", "time", preset.dt_max, **positive),

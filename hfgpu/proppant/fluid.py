@@ -130,12 +130,17 @@ class CourantLimitExceeded(SimulationError):
                          f"(Eq. 42); largest stable step {stable_dt:.6g} s")
 
 
-def courant_rate(u: np.ndarray, v: np.ndarray, dx: float, dz: float) -> float:
-    """max over cells of |u|/dx + |v|/dz [1/s] (Eq. 42 per unit dt), each component the larger of the cell's
+def courant_rates(u: np.ndarray, v: np.ndarray, dx: float, dz: float) -> np.ndarray:
+    """|u|/dx + |v|/dz [1/s] per cell (nz, nx) (Eq. 42 per unit dt), each component the larger of the cell's
     two faces."""
     ru = np.maximum(np.abs(u[:, :-1]), np.abs(u[:, 1:])) / dx
     rv = np.maximum(np.abs(v[:-1]), np.abs(v[1:])) / dz
-    return float(np.max(ru + rv))
+    return ru + rv
+
+
+def courant_rate(u: np.ndarray, v: np.ndarray, dx: float, dz: float) -> float:
+    """max over cells of :func:`courant_rates` [1/s]."""
+    return float(np.max(courant_rates(u, v, dx, dz)))
 
 
 class FluidSolver:

@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import SceneError
 from ..records import GridFrame
 from .config import Port, ProppantClass
-from .interpolation import active_nodes, weights
+from .interpolation import deposit_masks, weights
 
 PARCEL_KEYS = ("x", "z", "u", "v", "radius", "density", "particles", "state", "class_id")
 #: Random positions in its inlet a parcel is tried at before it is held back (screen-out).
@@ -224,7 +224,7 @@ class Injector:
         every cell it lands on (up to PLACEMENT_TRIES random positions in its inlet), else it is held back
         (``screened_out``). ``room`` (float64) is reduced in place by the parcels placed."""
         q = self.rate(t0, t1) * (t1 - t0)
-        mask = None if room is None else active_nodes(width)[0]
+        mask = None if room is None else deposit_masks(width)[0]
         batches = []
         for c, fraction in self.loadings(0.5 * (t0 + t1)):
             if fraction <= 0.0 or q <= 0.0:

@@ -43,6 +43,17 @@ def face_widths(width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return wx * xmask, wz * zmask
 
 
+def deposit_masks(width: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Node weights of the deposits (Eq. 38-39) on (cell, xface, zface): each active node's width, 0 elsewhere.
+    Passed to :func:`weights` as its ``mask``, they give I_k w_k / sum_j I_j w_j, so that a parcel's share of
+    node k divided by the node's volume dx dz w_k is V I_k / (dx dz sum_j I_j w_j), its bilinear share over the
+    mean width of its stencil: a narrow cell beside a loaded wide one (a fracture's tip, a cell that just
+    opened) gets a share like its neighbours', not w_wide / w_k times theirs. On a uniform width these are the
+    plain bilinear weights of :func:`active_nodes`'s masks."""
+    xface, zface = face_widths(width)
+    return np.where(width > 0.0, width, 0.0), xface, zface
+
+
 def owning_cell(x, z, frame: GridFrame, shape: tuple[int, int]):
     """(k, i, inside) of the cell containing each point; k, i are clipped into the grid."""
     nz, nx = shape

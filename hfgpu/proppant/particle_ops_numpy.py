@@ -14,7 +14,7 @@ import numpy as np
 from ..records import GridFrame
 from . import closures
 from .grid import face_mean
-from .interpolation import active_nodes, deposit, face_widths, interpolate, owning_cell, weights
+from .interpolation import active_nodes, deposit, deposit_masks, interpolate, owning_cell, weights
 from .params import MppicParams
 from .parcels import BRIDGED, SUSPENDED, Parcels
 
@@ -102,8 +102,8 @@ def moment_sums(parcels: Parcels, frame: GridFrame, width: np.ndarray) -> np.nda
     """Bilinear sums (7, nz, nx) of the MOMENT_CHANNELS over parcels (numerators of Eq. 38 and of the
     mass averages of O'Rourke & Snider 2010)."""
     shape = check_width(width)
-    cell_mask, _, _ = active_nodes(width)
-    k, i, w = weights(parcels.x, parcels.z, frame, "cell", cell_mask)
+    cell_weight, _, _ = deposit_masks(width)
+    k, i, w = weights(parcels.x, parcels.z, frame, "cell", cell_weight)
     vol = parcels.solid_volume()
     mass = vol * parcels.density
     values = (vol, mass, mass * parcels.u, mass * parcels.v, mass * (parcels.u ** 2 + parcels.v ** 2),
@@ -225,17 +225,23 @@ def _deposited(x, z, on_bed, seen: ParcelFluid, radius, rho_p, frame: GridFrame,
                                                                  fluid_viscosity, gravity))
 
 
-def _blocked(x, z, x_try, z_try, frame: GridFrame, fields: GridFields, params: MppicParams) -> np.ndarray:
-    """True where the move (x, z) -> (x_try, z_try) leaves the grid, enters a closed cell, raises the
+def _blocked(x, z, x_try, z_try, frame: GridFrame, fields: GridFields, params: MppicParams,
+             radius: np.ndarray) -> np.ndarray:
+    """True where the move (x, z) -> (x_try, z_try) leaves the grid, enters a closed cell, enters another cell
+    narrower than the parcel's bridging width (width < bridging_factor x 2 r: the grain bridges at the mouth of
+    an aperture it cannot pass, so proppant never reaches the narrow tip region of a growing fracture; inside
+    such a cell a point parcel would put theta_p = V_s / (w dx dz) above close packing), raises the
     bilinear weight (Eq. 37) of the parcel on a cell whose theta_p (Eq. 38, this step's scatter) is already
     >= theta_cp (the packing cap of push), or heads for a wall from a dense cell (_toward_wall_dense)."""
     k, i, inside = owning_cell(x_try, z_try, frame, fields.width.shape)
+    k_old, i_old, _ = owning_cell(x, z, frame, fields.width.shape)
+    narrow = ((k != k_old) | (i != i_old)) & (fields.width[k, i] < params.bridging_factor * 2.0 * radius)
     k0, i0, w0 = weights(x, z, frame, "cell", fields.cell_mask)
     k1, i1, w1 = weights(x_try, z_try, frame, "cell", fields.cell_mask)
     same = (k1[:, :, None] == k0[:, None, :]) & (i1[:, :, None] == i0[:, None, :])
     before = np.sum(w0[:, None, :] * same, axis=2)
     packed = fields.volume_fraction[k1, i1] >= params.theta_cp
-    return ~inside | (fields.width[k, i] <= 0.0) | np.any(packed & (w1 > before), axis=1) \
+    return ~inside | (fields.width[k, i] <= 0.0) | narrow | np.any(packed & (w1 > before), axis=1) \
         | _toward_wall_dense(x, z, x_try, z_try, frame, fields, params)
 
 
@@ -271,7 +277,8 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     (1 + dt (D + 1/(2 tau_D))), drag D(|u_f - u|) iterated ``drag_iterations`` times starting from u^o (the
     returned D is the one of the last solve). Then the stress term -dt grad tau / (theta_p rho_p (1 + ...)),
     limited per component by Snider (2001) eqs. 39-41 (packing limiter, see _limited_stress_velocity).
-    Walls, per component (x first): a move that would leave the grid, enter a closed cell, or raise the
+    Walls, per component (x first): a move that would leave the grid, enter a closed cell, enter another cell
+    narrower than the parcel's bridging width (bridging_factor x 2 r), or raise the
     parcel's bilinear weight on a cell whose theta_p (this step's scatter) is already >= theta_cp, or approach a
     wall within the half cell next to it when the parcel's own cell is dense (_toward_wall_dense),
     is cancelled and that velocity component set to 0 (inelastic stop). The last rule is our packing cap: Snider's limiter
@@ -309,11 +316,11 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     u_new = np.where(bridged, 0.0, u_new)
     v_new = np.where(bridged, 0.0, v_new)
     x_try = parcels.x + dt * u_new
-    blocked = _blocked(parcels.x, parcels.z, x_try, parcels.z, frame, fields, params)
+    blocked = _blocked(parcels.x, parcels.z, x_try, parcels.z, frame, fields, params, parcels.radius)
     x_new = np.where(blocked, parcels.x, x_try)
     u_new = np.where(blocked, 0.0, u_new)
     z_try = parcels.z + dt * v_new
-    blocked = _blocked(x_new, parcels.z, x_new, z_try, frame, fields, params)
+    blocked = _blocked(x_new, parcels.z, x_new, z_try, frame, fields, params, parcels.radius)
     z_new = np.where(blocked, parcels.z, z_try)
     v_new = np.where(blocked, 0.0, v_new)
     parcels.x[:] = x_new
@@ -340,12 +347,11 @@ def face_sums(parcels: Parcels, values_x: np.ndarray, values_z: np.ndarray, fram
     """Per-parcel values deposited with x-face and z-face weights (Eq. 37), per unit face volume dx dz w_face:
     sum value I / V_face on the x-faces (nz, nx+1) and the z-faces (nz+1, nx), 0 at inactive faces."""
     check_width(width)
-    _, xmask, zmask = active_nodes(width)
-    wxf, wzf = face_widths(width)
-    k, i, w = weights(parcels.x, parcels.z, frame, "xface", xmask)
-    sx = deposit(values_x, k, i, w, xmask.shape)
-    k, i, w = weights(parcels.x, parcels.z, frame, "zface", zmask)
-    sz = deposit(values_z, k, i, w, zmask.shape)
+    _, wxf, wzf = deposit_masks(width)
+    k, i, w = weights(parcels.x, parcels.z, frame, "xface", wxf)
+    sx = deposit(values_x, k, i, w, wxf.shape)
+    k, i, w = weights(parcels.x, parcels.z, frame, "zface", wzf)
+    sz = deposit(values_z, k, i, w, wzf.shape)
     return per_face_volume(sx, frame, wxf), per_face_volume(sz, frame, wzf)
 
 

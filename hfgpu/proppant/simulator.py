@@ -58,7 +58,8 @@ from ..errors import SimulationError
 from ..records import GridFrame, ProppantSnapshot, SolidBalanceRecord
 from .config import Geometry, Port, ProppantSetup
 from .engine import make_engine
-from .fluid import CourantLimitExceeded, FluidNumerics, FluidSolver, FluidState
+from .fluid import CourantLimitExceeded, FluidNumerics, FluidSolver, FluidState, courant_rates
+from .health import Watch
 from .grid import StaggeredGrid
 from .injection import Injector, batch_solid_volume, initial_suspension, ports_to_cells
 from .parcels import Parcels
@@ -87,19 +88,37 @@ def box_shape(geometry: Geometry, mesh) -> tuple[int, int]:
 
 def particles_per_parcel(setup: ProppantSetup, schedule, cell_volume: float) -> list[float]:
     """Real particles per parcel of each class: the scene's value, or so that ``parcels_per_cell`` parcels
-    fill a cell of volume ``cell_volume`` at the class's largest volume fraction (initial or injected)."""
+    fill a cell of volume ``cell_volume`` at the class's largest volume fraction (initial or injected); with
+    ``max_parcels`` (MppicNumerics), raised by one common factor where the schedule's proppant would make more
+    parcels than that (n_c = V_c / (ppp_c v_c) summed over the classes, V_c the class's scheduled solid volume,
+    v_c its mean particle volume)."""
     numerics = setup.numerics
     if numerics.particles_per_parcel is not None:
         return [numerics.particles_per_parcel] * len(setup.classes)
-    out = []
+    out, parcels = [], 0.0
     for cls in setup.classes:
         fraction = cls.initial_volume_fraction
         for stage in (schedule.stages if schedule is not None else ()):
             if stage.proppant == cls.name:
                 fraction = max(fraction, stage.volume_fraction, stage.end_volume_fraction)
         ppp = fraction * cell_volume / (numerics.parcels_per_cell * cls.size.mean_particle_volume())
-        out.append(ppp if ppp > 0.0 else 1.0)
+        ppp = ppp if ppp > 0.0 else 1.0
+        out.append(ppp)
+        parcels += scheduled_solid_volume(schedule, cls.name) / (ppp * cls.size.mean_particle_volume())
+    if numerics.max_parcels is not None and parcels > numerics.max_parcels:
+        out = [ppp * parcels / numerics.max_parcels for ppp in out]
     return out
+
+
+def scheduled_solid_volume(schedule, name: str) -> float:
+    """Solid volume [m^3] the schedule injects of proppant class ``name``: sum of Q T (f0 + f1) / 2 over its
+    stages (the slurry rate Q, the volume fraction ramped linearly from f0 to f1)."""
+    total, start = 0.0, 0.0
+    for stage in (schedule.stages if schedule is not None else ()):
+        if stage.proppant == name:
+            total += stage.rate * (stage.until - start) * 0.5 * (stage.volume_fraction + stage.end_volume_fraction)
+        start = stage.until
+    return total
 
 
 @dataclass(frozen=True)
@@ -167,6 +186,8 @@ class ProppantSimulation:
         self.fluid = self.solver.initial_state(self._fluid_theta_p())
         self.steps = 0
         self.safety = 1.0
+        self.limited_by = "dt_max"
+        self.watch = Watch(self.params.theta_cp, min(c.size.d_min for c in setup.classes), scene.output.units)
         self.fluid_totals = dict.fromkeys(FLUID_VOLUMES, 0.0)
 
     # -- set-up ---------------------------------------------------------------------------------------
@@ -209,21 +230,28 @@ class ProppantSimulation:
 
     # -- stepping -------------------------------------------------------------------------------------
 
-    def next_dt(self, limit: float) -> float:
-        """Largest step allowed: dt_max, the fluid Courant limit (Eq. 42), the parcels' Courant number per
-        sub-step (<= C_max), and ``limit`` (time to the next output, stage end or end time). The fluid limit
-        is scaled by ``safety``, which shrinks by 0.7 after a step needed a retry and recovers by 1.05 a step."""
+    def step_limits(self, limit: float) -> dict[str, float]:
+        """What bounds the next step [s] (keys of hfgpu.proppant.health.KEYS): dt_max, ``limit`` (time to the
+        next output, stage end or end time), the fluid Courant limit (Eq. 42) scaled by ``safety`` (which
+        shrinks by 0.7 after a step needed a retry and recovers by 1.05 a step) and the parcels' Courant number
+        per sub-step (<= C_max)."""
         h = min(self.grid.frame.dx, self.grid.frame.dz)
-        dt = min(self.numerics.dt_max, limit, self.safety * self.solver.stable_dt(self.fluid))
         speed = self.engine.max_speed()
-        if speed > 0.0:
-            dt = min(dt, self.numerics.c_max * h * self.numerics.particle_substeps / speed)
-        return dt
+        return {"dt_max": self.numerics.dt_max, "output": limit,
+                "fluid Courant": self.safety * self.solver.stable_dt(self.fluid),
+                "parcel Courant": (self.numerics.c_max * h * self.numerics.particle_substeps / speed
+                                   if speed > 0.0 else math.inf)}
+
+    def next_dt(self, limit: float) -> float:
+        """Largest step allowed: the smallest of :meth:`step_limits`."""
+        return min(self.step_limits(limit).values())
 
     def step(self, limit: float = math.inf) -> StepInfo:
         """Advance one fluid step (at most ``limit`` seconds); see the module docstring. A retry starts again
         from the parcels of the last accepted step (the engine keeps them until ``commit``)."""
-        dt = self.next_dt(limit)
+        limits = self.step_limits(limit)
+        dt = min(limits.values())
+        self.limited_by = min(limits, key=limits.get)
         t0 = self.time
         saved = (copy.deepcopy(self.injector), self.injected, self.screen_out_time)
         for retry in range(self.numerics.max_step_retries + 1):
@@ -265,6 +293,13 @@ class ProppantSimulation:
             self.fluid_totals[name] += getattr(info, name)
         self.safety = 0.7 * self.safety if retry else min(1.0, 1.05 * self.safety)
         self._check_fluid(t0 + dt)
+        if retry:  # cut by the fluid's Courant number as it came out (Eq. 42), not by the limit foreseen
+            limits = {**limits, "fluid Courant": dt}
+            self.limited_by = "fluid Courant"
+        theta = self.moments.volume_fraction
+        self.watch.check_step(t0, dt, min(self.numerics.dt_max, limit), limits, self.grid.frame,
+                              self._fastest_cell, np.asarray(self.grid.width), theta)
+        self.watch.after_step(t0 + dt, self.grid.frame, np.asarray(self.grid.width), theta)
         self.time = t0 + dt
         self.steps += 1
         return StepInfo(time=self.time, dt=dt, simple_iterations=info.iterations,
@@ -295,6 +330,12 @@ class ProppantSimulation:
         failed, reaches it). Not capped at close packing: the fluid's storage term (theta_f w)^n - (theta_f
         w)^o must follow the parcels, or a bed reaching theta_cp breaks continuity (seen to blow up)."""
         return np.minimum(self.moments.volume_fraction, 1.0 - 1e-6)
+
+    def _fastest_cell(self) -> tuple[int, int]:
+        """(k, i) of the cell with the fluid's largest Courant rate (Eq. 42)."""
+        rates = courant_rates(self.fluid.u, self.fluid.v, self.grid.frame.dx, self.grid.frame.dz)
+        k, i = np.unravel_index(int(np.argmax(rates)), rates.shape)
+        return int(k), int(i)
 
     def _check_fluid(self, t: float) -> None:
         for name in ("u", "v", "p"):
@@ -362,7 +403,7 @@ class ProppantSimulation:
                     in_domain=record.in_domain, outflow=record.outflow, screened_out=record.screened_out,
                     screen_out_time=self.screen_out_time,
                     max_continuity_residual=max_residual, backend=self.engine.name, arch=self.engine.arch,
-                    threads=self.engine.threads or 0,
+                    threads=self.engine.threads or 0, **self.watch.summary(),
                     **{f"fluid_{name}": value for name, value in self.fluid_totals.items()})
 
     # -- checkpoints ------------------------------------------------------------------------------------
@@ -372,14 +413,15 @@ class ProppantSimulation:
     def state(self) -> dict:
         """Everything needed to continue from now (a checkpoint): STATE_ATTRIBUTES, the fluid volumes, the parcels,
         the fluid fields, the width and leak-off the grid holds, the pressure solver's reused LU factors (as the
-        matrix factorised), the random generator's state (numpy ``bit_generator.state``, as JSON) and the
-        inlets' owed volumes and next diameters."""
+        matrix factorised), the random generator's state (numpy ``bit_generator.state``, as JSON), the unphysical
+        states already reported (hfgpu.proppant.health, as JSON) and the inlets' owed volumes and next diameters."""
         rng = self.injector.rng if self.injector is not None else self.rng  # a step retry deep-copies it
         state = {**{name: getattr(self, name) for name in self.STATE_ATTRIBUTES},
                  "fluid_totals": dict(self.fluid_totals), "parcels": self.parcels.as_dict(),
                  "fluid": {f.name: getattr(self.fluid, f.name).copy() for f in dataclasses.fields(self.fluid)},
                  "width": np.array(self.grid.width), "leakoff": self.leakoff.copy(),
-                 "linear": self.solver.linear.state(), "rng": json.dumps(rng.bit_generator.state)}
+                 "linear": self.solver.linear.state(), "rng": json.dumps(rng.bit_generator.state),
+                 "watch": json.dumps(self.watch.found)}
         if self.injector is not None:
             inlets = self.injector.inlets
             state["injector"] = {"screened_out": self.injector.screened_out,
@@ -400,6 +442,7 @@ class ProppantSimulation:
         self.solver.linear.restore(state["linear"])
         self.fluid = FluidState(**{name: np.array(a) for name, a in state["fluid"].items()})
         self.rng.bit_generator.state = json.loads(state["rng"])
+        self.watch.found = json.loads(state["watch"]) if "watch" in state else {}
         if self.injector is not None:
             self.injector.rng = self.rng
             self.injector.screened_out = state["injector"]["screened_out"]

@@ -319,6 +319,50 @@ def test_bridging_stops_and_releases(backend_name):
 
 
 @pytest.mark.parametrize("backend_name", BACKENDS)
+def test_parcels_do_not_enter_cells_they_would_bridge_in(backend_name):
+    """A parcel heading into a cell narrower than its bridging width (bridging_factor x 2 r, here 1.5 x 2 r)
+    stops at the face with that velocity component 0, and moves on into a cell just wide enough; one already
+    inside a cell that is narrow moves within it (bridged, it does not move at all)."""
+    nz, nx = 3, 4
+    frame = GridFrame(0.01, 0.01, 0.005, 0.005)
+    r = 1e-4
+    params = MppicParams(bridging_factor=2.0)
+    flow = dict(u=np.full((nz, nx + 1), 1.0), v=np.zeros((nz + 1, nx)), pressure=np.zeros((nz, nx)))
+    for factor, enters in ((0.75, False), (1.05, True)):
+        width = np.full((nz, nx), 2e-3)
+        width[1, 2] = factor * params.bridging_factor * 2 * r
+        parcels = Parcels.create(np.array([0.0195]), np.array([0.015]), radius=r, density=2650.0, particles=1.0,
+                                 u=np.array([1.0]))
+        particle_step(backend_name, frame, width, parcels, flow, params, dt=5e-3, gravity=0.0, substeps=5)
+        assert (parcels.x[0] > 0.02) == enters
+        if not enters:
+            assert parcels.u[0] == 0.0
+
+
+@pytest.mark.parametrize("backend_name", BACKENDS)
+def test_deposit_weights_follow_the_width(backend_name):
+    """A parcel beside a narrow cell (a fracture's tip: 1 % of its neighbours' width) deposits V I_k w_k /
+    sum_j I_j w_j on each node, so node k gets theta_p = V I_k / (dx dz sum_j I_j w_j), its bilinear share over
+    the stencil's mean width, and the scattered volume is the parcel's (Eq. 38); with the plain bilinear
+    weights the narrow cell would get V I_k / (dx dz w_k), 70 times that."""
+    frame = GridFrame(dx=0.01, dz=0.01, x0=0.005, z0=0.005)
+    width = np.full((3, 3), 2e-3)
+    width[1, 2] = 2e-5
+    x, z = 0.0185, 0.0135  # fractional position (0.35, 0.85) in the stencil of cells (0..1, 1..2)
+    parcels = Parcels.create(np.array([x]), np.array([z]), radius=1e-4, density=2650.0, particles=1.0)
+    engine = engine_for(backend_name, frame, width, MppicParams())
+    engine.set_parcels(parcels)
+    theta = engine.moments().volume_fraction
+    fx, fz = 0.35, 0.85
+    plain = {(0, 1): (1 - fz) * (1 - fx), (0, 2): (1 - fz) * fx, (1, 1): fz * (1 - fx), (1, 2): fz * fx}
+    mean_width = sum(w * width[c] for c, w in plain.items())
+    expected = parcels.solid_volume()[0] / (frame.dx * frame.dz * mean_width)
+    for cell, share in plain.items():
+        assert theta[cell] == pytest.approx(share * expected, rel=1e-12)
+    assert np.sum(theta * frame.dx * frame.dz * width) == pytest.approx(parcels.solid_volume()[0], rel=1e-12)
+
+
+@pytest.mark.parametrize("backend_name", BACKENDS)
 def test_bad_fluid_shapes_are_named(backend_name):
     frame, width, parcels, fluid = random_case(n=10)
     engine = engine_for(backend_name, frame, width, MppicParams())
