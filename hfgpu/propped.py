@@ -24,7 +24,15 @@ group gives its share of the parcels, its median and 90th-percentile speed and, 
 below the threshold of motion: Shields number tau_b / ((rho_p - rho_f) g d) < theta_cr with tau_b = f_t
 sqrt(12) mu |u_f| / w of the fluid's x velocity at the parcel (hfgpu.proppant.closures; docs/proppant-closures.md).
 
-Public API: ``areal_solid(snap)``, ``propped_cells(snap, theta_cp, layers=1.0)``, ``created_area(snap)``,
+*Headline numbers* (:func:`headline_propped`, the one source of the run summary, ``propped_area.png``, the
+sweep's metrics and maps): ``propped_area`` is the area propped after closure (hfgpu.closure: the grains settled
+by ``[closure] settling``, at least ``[closure] layers`` packed layers per cell, at ``[closure] time``);
+``propped_area_in_place`` is the one-layer rule above on the same snapshot with the grains where it holds them.
+Both fractions are of the same ``created_area``: the fracture's final open area (one face; ``/summary`` ``area``),
+or the open cells of the proppant grid in a proppant-only run. :data:`DEFINITIONS` words each for a label.
+
+Public API: ``headline_propped(results)``, ``headline_created_area(results)``, ``closure_area_history(results)``,
+``areal_solid(snap)``, ``propped_cells(snap, theta_cp, layers=1.0)``, ``created_area(snap)``,
 ``packed_fraction(parcels, speed_threshold)``, ``shields_ratio(snap, setup, ...)``, ``parcel_groups(snap, setup,
 ...)``, ``area_history(results, ...)``, ``fracture_area_history(results)``,
 ``packed_history(results, times, ...)``, ``propped_summary(results, ...)``, ``equivalent_times(start, end)``.
@@ -45,6 +53,9 @@ PACKED_SPEED = 1e-3
 GROUPS = ("suspended", "moving bed", "bed at rest", "bridged")
 #: Times [s] of the paper's probability plots (Fig. 16).
 PAPER_TIMES = (1260.0, 1800.0, 3600.0)
+#: Each headline propped-area number by the name every output carries, and its definition in words.
+DEFINITIONS = {"propped_area": "after closure (grains settled, [closure] layers packed layers)",
+               "propped_area_in_place": "one packed grain layer, grains in place (no settling)"}
 
 
 def equivalent_times(start: float, end: float) -> tuple[float, ...]:
@@ -205,7 +216,8 @@ def packed_history(results: Any, times: tuple[float, ...] | None = None,
 
 def propped_summary(results: Any, theta_cp: float | None = None, layers: float = 1.0,
                     speed_threshold: float = PACKED_SPEED) -> dict[str, float]:
-    """At the last proppant snapshot: created_area, propped_area [m^2], propped_fraction, packed_fraction,
+    """The paper study's numbers (the in-place rule, not the headline: :func:`headline_propped`). At the last
+    proppant snapshot: created_area, propped_area [m^2], propped_fraction, packed_fraction,
     screen_out_cells (cells flagged ``bridging_risk``, 0 when the file has no such field), time."""
     results = _results(results)
     snap = results.proppant_snapshots[-1]
@@ -217,3 +229,47 @@ def propped_summary(results: Any, theta_cp: float | None = None, layers: float =
                 propped_fraction=propped / created if created > 0.0 else float("nan"),
                 packed_fraction=packed_fraction(snap.parcels, speed_threshold),
                 screen_out_cells=int(np.count_nonzero(risk)) if risk is not None else 0)
+
+
+def headline_created_area(results: Any, snap: ProppantSnapshot | None = None) -> float:
+    """The created area [m^2] every headline fraction is of (one face): ``/summary`` ``area`` (``fracture_area``
+    in a coupled run), else the open cells of ``snap`` (proppant-only runs; NaN without either)."""
+    s = _results(results).summary
+    for key in ("area", "fracture_area"):
+        if key in s and np.isfinite(float(s[key])):
+            return float(s[key])
+    return created_area(snap) if snap is not None else float("nan")
+
+
+def headline_propped(results: Any, scene: Any = None) -> dict[str, float]:
+    """The headline propped-area numbers of a results file (module docstring; ``scene`` defaults to the stored
+    one): time [s] of the closed snapshot, created_area, propped_area, propped_area_in_place [m^2] and the
+    fractions propped_fraction = propped_area / created_area, propped_fraction_in_place likewise."""
+    from .closure.conductivity import closure_of
+
+    results = _results(results)
+    closure = closure_of(results, scene)
+    snap = results.proppant_snapshots.at(closure.scalars["time"])
+    theta_cp = (results.scene if scene is None else scene).proppant.params.theta_cp
+    in_place = float(propped_cells(snap, theta_cp).sum()) * snap.frame.dx * snap.frame.dz
+    created = headline_created_area(results, snap)
+    propped = float(closure.scalars["propped_area"])
+
+    def share(area: float) -> float:
+        return area / created if created > 0.0 else float("nan")
+
+    return dict(time=float(closure.scalars["time"]), created_area=created, propped_area=propped,
+                propped_fraction=share(propped), propped_area_in_place=in_place,
+                propped_fraction_in_place=share(in_place))
+
+
+def closure_area_history(results: Any, scene: Any = None) -> dict[str, np.ndarray]:
+    """time [s] and ``propped_area`` [m^2] after closure (:func:`headline_propped`'s definition) of every proppant
+    snapshot: the walls closed on each snapshot's grains in turn (``scene`` defaults to the stored one)."""
+    from .closure.conductivity import close
+
+    results = _results(results)
+    scene = results.scene if scene is None else scene
+    rows = [(snap.time, close(snap, scene).scalars["propped_area"]) for snap in results.proppant_snapshots]
+    time, area = np.array(rows, dtype=np.float64).reshape(-1, 2).T
+    return dict(time=time, propped_area=area)

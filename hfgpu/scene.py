@@ -249,6 +249,7 @@ class Scene:
     proppant: Any = None  # hfgpu.proppant.config.ProppantSetup when "proppant" in physics
     coupling: Any = None  # hfgpu.coupled.CouplingConfig when physics has both "fracture" and "proppant"
     closure: Any = None  # hfgpu.closure.config.ClosureConfig when "proppant" in physics
+    wellbore: Any = None  # hfgpu.wellbore.Wellbore when the scene has [wellbore] (with [injection])
     source: str = field(default="", repr=False, compare=False)  # the TOML text, stored in results
     #: One line each: what the scene reader found suspect but valid (bare numbers); hfgpu.scene_checks adds more.
     warnings: tuple[str, ...] = field(default=(), repr=False, compare=False)
@@ -403,6 +404,15 @@ def _parse(data: dict, source: str) -> Scene:
     if needs_rock or top.has("injection"):
         densities = None if proppant_failed else (proppant.class_densities() if proppant is not None else {})
         injection = sections(("injection",), lambda: _parse_injection(top.table("injection"), densities))
+    wellbore = None
+    if top.has("wellbore") and injection is not None:
+        from .wellbore import parse_wellbore
+
+        wellbore = sections(("wellbore",), lambda: parse_wellbore(top.table("wellbore"), injection.depth))
+    elif top.has("wellbore"):
+        top.raw("wellbore")
+        if not top.has("injection"):
+            sections.errors.append(SceneError("wellbore", "(table)", "this section needs [injection]"))
     if len(physics) > 1:
         if run is None or mesh is None:
             sections.skip("coupling")
@@ -420,7 +430,8 @@ def _parse(data: dict, source: str) -> Scene:
     from .defaults import derive
 
     scene = Scene(run=run, fluid=fluid, mesh=mesh, output=output, rock=rock, injection=injection,
-                  fracture=fracture, proppant=proppant, coupling=coupling, closure=closure, source=source)
+                  fracture=fracture, proppant=proppant, coupling=coupling, closure=closure, wellbore=wellbore,
+                  source=source)
     return derive(scene, data, preset)[0]
 
 

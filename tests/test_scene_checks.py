@@ -93,9 +93,9 @@ def test_check_reports_in_the_scene_units_with_the_pump_schedule(tmp_path, capsy
                         "units field (the scene's values: 15 in field units, 0 in SI; set [output] units to choose)")
     assert lines[-4:] == [
         "pump schedule",
-        "  stage         start [s]  end [s]  rate [bbl/min]  clean [bbl]  slurry [bbl]",
-        "  1      fluid          0    1 200              20          400           400",
-        "  total                      1 200                          400           400"]
+        "  stage         start [min]  end [min]  rate [bbl/min]  clean [bbl]  slurry [bbl]",
+        "  1      fluid            0         20              20          400           400",
+        "  total                             20                          400           400"]
 
 
 # --- one rule each: a bad scene, the exact message --------------------------------------------------------------
@@ -308,13 +308,13 @@ SUMMARY = {  # a coupled run's summary as the runner makes it (fracture_* from t
 
 
 @pytest.mark.parametrize("system, expect", [
-    ("SI", {"created area": "2 000 m^2", "width at the perforation": "4 mm", "net pressure at the end": "1.5 MPa",
+    ("SI", {"created area (one face)": "2 000 m^2", "width at the perforation": "4 mm", "net pressure at the end": "1.5 MPa",
             "pumped": "15 m^3", "fluid efficiency": "60 %", "held back at the inlet": "795 kg (20 % of pumped)",
-            "screen-out began": "never", "propped area": "500 m^2 (25 % of created)"}),
-    ("field", {"created area": "21 530 ft^2", "width at the perforation": "0.1575 in",
+            "screen-out began": "never", "propped area (after closure)": "500 m^2 (25 % of created)"}),
+    ("field", {"created area (one face)": "21 530 ft^2", "width at the perforation": "0.1575 in",
                "net pressure at the end": "217.6 psi", "pumped": "94.35 bbl", "fluid efficiency": "60 %",
                "held back at the inlet": "1 753 lb (20 % of pumped)", "screen-out began": "never",
-               "propped area": "5 382 ft^2 (25 % of created)"}),
+               "propped area (after closure)": "5 382 ft^2 (25 % of created)"}),
 ])
 def test_grouped_summary_in_si_and_field(system, expect):
     expect = dict(expect)

@@ -41,8 +41,8 @@ DESIGNS = ("latin-hypercube", "grid", "random")
 DISTRIBUTIONS = {"uniform": ("low", "high"), "log-uniform": ("low", "high"), "normal": ("mean", "std"),
                  "triangular": ("low", "mode", "high")}
 #: Metrics a sweep can ask for (hfgpu.ensemble.metrics says how each is computed); the default set is all.
-METRIC_NAMES = ("propped_area", "created_area", "propped_fraction", "fracture_height", "fracture_length",
-                "net_pressure_end", "efficiency", "screened_out")
+METRIC_NAMES = ("propped_area", "propped_area_in_place", "created_area", "propped_fraction", "fracture_height",
+                "fracture_length", "net_pressure_end", "efficiency", "screened_out")
 
 
 class SweepError(SceneError):

@@ -231,20 +231,50 @@ def area_efficiency(results: Results, units: FigureUnits | None = None) -> Figur
 
 
 def pressure_history(results: Results, units: FigureUnits | None = None) -> Figure:
-    """Net pressure at the injection cell [MPa or psi] against time, linear and log-log (a Nolte-Smith plot: slope
-    1/4 to 1/5 for a confined PKN-like fracture, negative for a radial or unconfined one), from the step
-    history (/fracture/balance)."""
+    """Pressures against time from the step history (/fracture/balance), in MPa or psi: the net pressure at the
+    injection cell (BHTP less the minimum stress there), linear; the bottom-hole treating pressure (BHTP, the
+    fluid pressure in the perforated cell; with ``[wellbore]`` the surface treating pressure, hfgpu.wellbore) with
+    the end of pumping and the ISIP (hfgpu.io.summary.treatment_pressures) marked; the net pressure log-log
+    while pumping only (a Nolte-Smith plot: slope 1/4 to 1/5 for a confined PKN-like fracture, negative for a
+    radial or unconfined one; the shut-in decline is not a power law of the time since the start and stays on
+    the linear panels), positive values only, labelled at the decades (no minor tick labels)."""
+    from matplotlib.ticker import NullFormatter
+
+    from .summary import pump_end, surface_history, treatment_pressures
+
     u = _units(results, units)
     b = results.fracture_balance
-    fig = Figure(figsize=(10, 4), layout="constrained")
-    left, right = fig.subplots(1, 2)
+    fig = Figure(figsize=(14, 4), layout="constrained")
+    left, middle, right = fig.subplots(1, 3)
     t, net = b["time"], u("pressure", b["net_pressure"])
-    label = f"net pressure at injection [{u.label('pressure')}]"
+    unit = u.label("pressure")
+    label = f"net pressure at injection [{unit}]"
     left.plot(t, net)
     left.set(xlabel="time [s]", ylabel=label, title="net pressure")
-    positive = (t > 0) & (net > 0)
+    try:
+        stop = pump_end(results.scene)
+    except (HfgpuError, ImportError):
+        stop = None
+    middle.plot(t, u("pressure", b["injection_pressure"]), label="BHTP")
+    try:
+        stp = surface_history(b, results.scene)
+    except (HfgpuError, ImportError):
+        stp = None
+    if stp is not None:
+        middle.plot(t, u("pressure", stp), label="STP (surface, [wellbore])")
+    shut_in = treatment_pressures(b, stop)
+    if shut_in:
+        middle.axvline(stop, color="k", ls=":", lw=1, label="pumps stop")
+        middle.plot([shut_in["isip_time"]], [u("pressure", shut_in["isip"])], "rv",
+                    label=f"ISIP {_number(float(u('pressure', shut_in['isip'])))} {unit}")
+    middle.set(xlabel="time [s]", ylabel=f"treating pressure [{unit}]", title="bottom-hole treating pressure")
+    middle.legend(fontsize="small")
+    pumping = np.ones(t.shape, dtype=bool) if stop is None else t <= stop
+    positive = pumping & (t > 0) & (net > 0)
     right.loglog(t[positive], net[positive])
-    right.set(xlabel="time [s]", ylabel=label, title="log-log (Nolte-Smith)")
+    right.xaxis.set_minor_formatter(NullFormatter())
+    right.yaxis.set_minor_formatter(NullFormatter())
+    right.set(xlabel="time [s]", ylabel=label, title="log-log while pumping (Nolte-Smith)")
     return fig
 
 
@@ -256,13 +286,24 @@ def volume_balance(results: Results, units: FigureUnits | None = None) -> Figure
 
 
 def proppant_balance(results: Results, units: FigureUnits | None = None) -> Figure:
-    """Injected, in-domain, outflow and held-back (screened out at the inlet, when the file has it) solid volume
-    [m^3 or ft^3] vs time; their sum dotted (it should cover injected)."""
+    """Injected, in-domain, outflow and held-back (screened out at the inlet, when the file has it) proppant vs
+    time, as the run summary gives it: a mass [kg or lb] where every class has the same grain density
+    (hfgpu.io.summary.shared_density), else a solid volume [m^3 or ft^3]; their sum dotted (it should cover
+    injected)."""
+    from .summary import shared_density
+
     names = ("injected", "in_domain", "outflow") + (("screened_out",) if "screened_out" in results.proppant_balance
                                                     else ())
-    return _balance(results.proppant_balance, names, "proppant (solid) volume balance",
+    try:
+        density = shared_density(results.scene)
+    except (HfgpuError, ImportError):
+        density = None
+    b = results.proppant_balance
+    if density is not None:
+        b = {k: v * density if k in names else v for k, v in b.items()}
+    return _balance(b, names, "proppant balance" if density is not None else "proppant (solid) volume balance",
                     {"in_domain": "in the domain", "screened_out": "held back at the inlet (screened out)"},
-                    units=_units(results, units), kind="solid_volume")
+                    units=_units(results, units), kind="mass" if density is not None else "solid_volume")
 
 
 def _balance(b: dict[str, np.ndarray], names: tuple[str, ...], title: str,
@@ -276,7 +317,7 @@ def _balance(b: dict[str, np.ndarray], names: tuple[str, ...], title: str,
         ax.plot(b["time"], units(kind, b[name]), label=labels.get(name, name))
     ax.plot(b["time"], units(kind, sum(b[name] for name in names[1:])), "k:",
             label=" + ".join(labels.get(name, name).split(" (")[0] for name in names[1:]))
-    ax.set(xlabel="time [s]", ylabel=f"volume [{units.label(kind)}]", title=title)
+    ax.set(xlabel="time [s]", ylabel=f"{'mass' if kind == 'mass' else 'volume'} [{units.label(kind)}]", title=title)
     ax.legend()
     return fig
 
@@ -400,19 +441,26 @@ def speed_probability(results: Results, times: tuple[float, ...] | None = None,
 
 def propped_area(results: Results, units: FigureUnits | None = None) -> Figure:
     """Fracture area (fracture snapshots), created and propped area (proppant grid) [m^2 or ft^2] vs time
-    (Fig. 18)."""
-    from ..propped import area_history, fracture_area_history
+    (Fig. 18). The propped area is drawn by both definitions of :data:`hfgpu.propped.DEFINITIONS`: after closure
+    (the run summary's headline, its closed snapshot marked) and one layer in place."""
+    from ..propped import DEFINITIONS, area_history, closure_area_history, fracture_area_history, headline_propped
 
     u = _units(results, units)
     fig = Figure(figsize=(7, 4.5), layout="constrained")
     ax = fig.subplots()
     frac = fracture_area_history(results)
-    ax.plot(frac["time"], u("area", frac["area"]), label="fracture area")
+    ax.plot(frac["time"], u("area", frac["area"]), label="fracture area (one face)")
     areas = area_history(results)
     ax.plot(areas["time"], u("area", areas["created"]), "--", label="open area (proppant grid)")
-    ax.plot(areas["time"], u("area", areas["propped"]), "o-", ms=3, label="propped area")
+    closed = closure_area_history(results)
+    ax.plot(closed["time"], u("area", closed["propped_area"]), "o-", ms=3,
+            label=f"propped area, {DEFINITIONS['propped_area']}")
+    ax.plot(areas["time"], u("area", areas["propped"]), "s:", ms=3,
+            label=f"propped area, {DEFINITIONS['propped_area_in_place']}")
+    head = headline_propped(results)
+    ax.plot([head["time"]], [u("area", head["propped_area"])], "k*", ms=10, label="run summary's propped area")
     ax.set(xlabel="time [s]", ylabel=f"area [{u.label('area')}]", title="created and propped area")
-    ax.legend()
+    ax.legend(fontsize="small")
     return fig
 
 

@@ -5,15 +5,26 @@ docs/cli.md). The results file keeps every summary key in SI (``/summary``); the
 Summary groups and rows (a row whose value the run did not produce is left out; a time that never came, such as a
 screen-out that did not happen, reads "never"):
 
-* fracture: created area, length (tip to tip), height, width at the perforation, net pressure at the end;
-* fluid: pumped, in the fracture, leaked off, fluid efficiency, fluid pressure at the perforation at the end;
+* fracture (at the end of the run): created area (one face), length (tip to tip), height (the tallest column's
+  open extent, hfgpu.fracture.geometry), width at the perforation, net pressure at the end;
+* end of pumping (when the pumps stop before the end of the run, read from ``/fracture/balance``: the last record
+  at or before :func:`pump_end`): length, height, net pressure, BHTP (and STP) there, and the ISIP (and at the
+  surface);
+* fluid: pumped, in the fracture, leaked off, fluid efficiency, bottom-hole treating pressure (BHTP) at the end,
+  and with ``[wellbore]`` the surface treating pressure (STP, :mod:`hfgpu.wellbore`) at the end;
 * proppant: pumped, in the fracture (in the domain, for a proppant-only run), held back at the inlet (screen-out) and when it began, left the domain, parcels,
-  and the closure results (propped area and its share of the created area, propped half-length and height, mean
+  and the closure results (propped area after closure, hfgpu.propped.headline_propped, and its share of the created
+  area, propped half-length and height, mean
   conductivity, F_CD, at which time);
 * run: status, simulated time, wall time, fracture and proppant steps, volume balance error, proppant engine,
   resumed from, results file.
 
-Proppant amounts are masses where every class has the same grain density, else solid volumes.
+Proppant amounts are masses where every class has the same grain density, else solid volumes. Numbers are
+written by :func:`hfgpu.units.format_number` (4 significant figures, thousands grouped by a thin space).
+
+Pressures (:func:`treatment_pressures`): BHTP is the fluid pressure in the perforated cell (``injection_pressure``
+of ``/fracture/balance``, absolute like the layer stresses); ISIP is the BHTP of the first record after the pumps
+stop (the first step of the shut-in: no extrapolation, the record itself).
 """
 
 from __future__ import annotations
@@ -21,12 +32,14 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
+
 from ..closure.display import in_units as closure_in_units
 from ..closure.display import unit_label as closure_unit
 from ..units import display_unit, format_number, in_display_units
 
 #: The groups in the order they are printed.
-GROUPS = ("fracture", "fluid", "proppant", "run")
+GROUPS = ("fracture", "end of pumping", "fluid", "proppant", "run")
 
 
 def _first(summary: dict, *keys: str) -> Any:
@@ -52,11 +65,11 @@ def _percent(value: Any, digits: int = 3) -> str | None:
 
 
 def _count(value: Any) -> str | None:
-    return f"{int(value)}" if _finite(value) else None
+    return format_number(float(int(value)), max(len(str(abs(int(value)))), 1)) if _finite(value) else None
 
 
-def _when(value: Any) -> str:
-    return f"{format_number(float(value))} s" if _finite(value) else "never"
+def _when(value: Any, system: str = "SI") -> str:
+    return _quantity(value, "time", system) if _finite(value) else "never"
 
 
 def _proppant_amount(value: Any, density: float | None, system: str) -> str | None:
@@ -67,10 +80,50 @@ def _proppant_amount(value: Any, density: float | None, system: str) -> str | No
     return _quantity(value, "solid_volume", system)
 
 
-def summary_rows(summary: dict[str, Any], system: str = "SI",
-                 density: float | None = None) -> list[tuple[str, str, str]]:
+def pump_end(scene: Any) -> float | None:
+    """The time [s] the pumps stop: the end of the last stage pumping at a rate > 0; None without a schedule."""
+    stages = scene.injection.schedule.stages if getattr(scene, "injection", None) is not None else ()
+    pumping = [stage.until for stage in stages if stage.rate > 0.0]
+    return float(pumping[-1]) if pumping else None
+
+
+def treatment_pressures(balance: dict[str, np.ndarray], stop: float | None,
+                        stp: np.ndarray | None = None) -> dict[str, float]:
+    """From a fracture step history (``/fracture/balance``) and the time the pumps stop: the state at the end of
+    pumping, the last record at or before ``stop`` (``pumping_time`` [s], ``pumping_length``, ``pumping_height``
+    [m], ``pumping_net_pressure``, ``pumping_bhtp`` [Pa]), and ``isip`` [Pa], the BHTP of the first record after
+    ``stop``, at ``isip_time`` [s]. With ``stp``, the surface treating pressure of each record
+    (:func:`hfgpu.wellbore.surface_pressure`), also ``pumping_stp`` and ``isip_surface`` [Pa]. Empty when the
+    history has no record after ``stop`` (the run ended pumping, or no stop)."""
+    time = np.asarray(balance.get("time", ()), dtype=np.float64)
+    if stop is None or not time.size or time[-1] <= stop or time[0] > stop:
+        return {}
+    last = int(np.searchsorted(time, stop, side="right")) - 1
+    out = dict(pumping_time=time[last], pumping_length=balance["length"][last],
+               pumping_height=balance["height"][last], pumping_net_pressure=balance["net_pressure"][last],
+               pumping_bhtp=balance["injection_pressure"][last], isip=balance["injection_pressure"][last + 1],
+               isip_time=time[last + 1])
+    if stp is not None:
+        out.update(pumping_stp=stp[last], isip_surface=stp[last + 1])
+    return {k: float(v) for k, v in out.items()}
+
+
+def surface_history(balance: dict[str, np.ndarray] | None, scene: Any) -> np.ndarray | None:
+    """The STP [Pa] of each record of ``/fracture/balance`` for a scene with ``[wellbore]`` (else None)."""
+    if not balance or getattr(scene, "wellbore", None) is None:
+        return None
+    from ..wellbore import surface_pressure
+
+    return surface_pressure(scene, balance["time"], balance["injection_pressure"])
+
+
+def summary_rows(summary: dict[str, Any], system: str = "SI", density: float | None = None,
+                 pressures: dict[str, float] | None = None,
+                 stp_end: float | None = None) -> list[tuple[str, str, str]]:
     """(group, label, value with its unit) of the rows the table shows, in order; ``density`` [kg/m^3] is the
-    proppant's grain density when all classes share it (amounts then shown as masses)."""
+    proppant's grain density when all classes share it (amounts then shown as masses); ``pressures`` is
+    :func:`treatment_pressures` of the run (no end-of-pumping group without it); ``stp_end`` the STP [Pa] of the
+    last record (no STP row without it)."""
     s = summary
     rows: list[tuple[str, str, str | None]] = []
 
@@ -78,17 +131,30 @@ def summary_rows(summary: dict[str, Any], system: str = "SI",
         rows.append((group, label, text))
 
     area = _first(s, "area", "fracture_area")
-    add("fracture", "created area", _quantity(area, "area", system))
+    add("fracture", "created area (one face)", _quantity(area, "area", system))
     add("fracture", "length (tip to tip)", _quantity(_first(s, "length", "fracture_length"), "length", system))
     add("fracture", "height", _quantity(_first(s, "height", "fracture_height"), "length", system))
     add("fracture", "width at the perforation", _quantity(_first(s, "w_inlet", "fracture_w_inlet"), "width", system))
     add("fracture", "net pressure at the end", _quantity(s.get("net_pressure_end"), "pressure", system))
+    p = pressures or {}
+    if p:
+        add("end of pumping", "at", _when(p["pumping_time"], system))
+        add("end of pumping", "length (tip to tip)", _quantity(p["pumping_length"], "length", system))
+        add("end of pumping", "height", _quantity(p["pumping_height"], "length", system))
+        add("end of pumping", "net pressure", _quantity(p["pumping_net_pressure"], "pressure", system))
+        add("end of pumping", "BHTP", _quantity(p["pumping_bhtp"], "pressure", system))
+        add("end of pumping", "STP", _quantity(p.get("pumping_stp"), "pressure", system))
+        isip = _quantity(p["isip"], "pressure", system)
+        add("end of pumping", "ISIP", f"{isip} (first record after, {_when(p['isip_time'], system)})" if isip else None)
+        add("end of pumping", "ISIP at surface", _quantity(p.get("isip_surface"), "pressure", system))
 
     add("fluid", "pumped", _quantity(s.get("injected_volume"), "volume", system))
     add("fluid", "in the fracture", _quantity(s.get("stored_volume"), "volume", system))
     add("fluid", "leaked off", _quantity(s.get("leaked_volume"), "volume", system))
     add("fluid", "fluid efficiency", _percent(s.get("efficiency")))
-    add("fluid", "pressure at the perforation, end", _quantity(s.get("injection_pressure_end"), "pressure", system))
+    add("fluid", "BHTP (bottom-hole treating pressure), end", _quantity(s.get("injection_pressure_end"), "pressure",
+                                                                         system))
+    add("fluid", "STP (surface treating pressure), end", _quantity(stp_end, "pressure", system))
 
     pumped = s.get("proppant_injected")
     add("proppant", "pumped", _proppant_amount(pumped, density, system))
@@ -100,7 +166,7 @@ def summary_rows(summary: dict[str, Any], system: str = "SI",
         if pumped > 0 and screened > 0:
             held += f" ({format_number(100.0 * screened / pumped, 3)} % of pumped)"
         add("proppant", "held back at the inlet", held)
-        add("proppant", "screen-out began", _when(_first(s, "proppant_screen_out_time", "screen_out_time")))
+        add("proppant", "screen-out began", _when(_first(s, "proppant_screen_out_time", "screen_out_time"), system))
     outflow = s.get("proppant_outflow")
     if _finite(outflow) and outflow > 0:
         add("proppant", "left the domain", _proppant_amount(outflow, density, system))
@@ -110,14 +176,16 @@ def summary_rows(summary: dict[str, Any], system: str = "SI",
         text = f"{format_number(closure_in_units('propped_area', propped, system))} {closure_unit('propped_area', system)}"
         if _finite(area) and area > 0:
             text += f" ({format_number(100.0 * propped / area, 3)} % of created)"
-        add("proppant", "propped area", text)
+        add("proppant", "propped area (after closure)", text)
         for name, label in (("propped_half_length", "propped half-length"), ("propped_height", "propped height"),
                             ("mean_conductivity", "mean conductivity"), ("fcd", "F_CD")):
             value = s.get(f"closure_{name}")
             if _finite(value):
                 unit = closure_unit(name, system)
                 add("proppant", label, f"{format_number(closure_in_units(name, value, system))} {unit}".rstrip())
-        add("proppant", "closure at", _when(s.get("closure_time")))
+        if s.get("closure_permeability_model") == "kozeny-carman":
+            add("proppant", "permeability", "Kozeny-Carman, independent of closure stress (no conductivity table)")
+        add("proppant", "closure at", _when(s.get("closure_time"), system))
 
     add("run", "status", str(s["status"]) if "status" in s else None)
     add("run", "simulated time", _quantity(s.get("sim_time"), "time", system))
@@ -131,7 +199,7 @@ def summary_rows(summary: dict[str, Any], system: str = "SI",
         arch = _first(s, "proppant_arch", "arch")
         add("run", "proppant engine", f"{backend}" + (f" ({arch})" if arch else ""))
     if _finite(s.get("resumed_from")):
-        add("run", "resumed from", _when(s["resumed_from"]))
+        add("run", "resumed from", _when(s["resumed_from"], system))
     add("run", "results file", str(s["out"]) if "out" in s else None)
     return [(g, label, text) for g, label, text in rows if text is not None]
 
@@ -155,9 +223,22 @@ def shared_density(scene: Any) -> float | None:
     return densities.pop() if len(densities) == 1 else None
 
 
-def summary_table(summary: dict[str, Any], system: str = "SI", scene: Any = None) -> str:
-    """The run's summary as a grouped text table (fracture, fluid, proppant, run) in ``system``'s units."""
-    return _table(summary_rows(summary, system, shared_density(scene)))
+def summary_table(summary: dict[str, Any], system: str = "SI", scene: Any = None,
+                  balance: dict[str, np.ndarray] | None = None) -> str:
+    """The run's summary as a grouped text table (:data:`GROUPS`) in ``system``'s units; ``balance`` is the run's
+    ``/fracture/balance`` (default: read from the summary's results file ``out`` when there is one)."""
+    if balance is None and "out" in summary:
+        from ..errors import HfgpuError
+        from .results import open_results
+
+        try:
+            balance = open_results(summary["out"]).fracture_balance
+        except (HfgpuError, OSError):
+            balance = None
+    stp = surface_history(balance, scene)
+    pressures = treatment_pressures(balance, pump_end(scene), stp) if balance and scene is not None else None
+    stp_end = float(stp[-1]) if stp is not None and stp.size else None
+    return _table(summary_rows(summary, system, shared_density(scene), pressures, stp_end))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -199,14 +280,18 @@ def schedule_rows(scene: Any) -> list[dict[str, Any]]:
 
 
 def schedule_table(scene: Any, system: str = "SI") -> str:
-    """The pump schedule as a text table in ``system``'s units, with a total row."""
+    """The pump schedule as a text table in ``system``'s units (times in minutes in field units), with a total
+    row."""
     rows = schedule_rows(scene)
-    u = {kind: display_unit(kind, system) for kind in ("rate", "volume", "mass", "concentration", "time")}
+    u = {kind: display_unit(kind, system) for kind in ("rate", "volume", "mass", "concentration")}
+    u["time"] = "min" if system == "field" else display_unit("time", system)
     header = ["stage", "", f"start [{u['time']}]", f"end [{u['time']}]", f"rate [{u['rate']}]",
               f"clean [{u['volume']}]", f"slurry [{u['volume']}]", f"proppant [{u['mass']}]",
               f"conc. [{u['concentration']}]"]
 
     def number(value: Any, kind: str) -> str:
+        if kind == "time" and system == "field":
+            return format_number(value / 60.0)
         return "-" if value is None else format_number(in_display_units(value, kind, system))
 
     body = []

@@ -95,13 +95,17 @@ class Watch:
         if not (nominal > 0.0 and math.isfinite(nominal)) or dt >= COLLAPSE_WARNING * nominal:
             return
         bound = min(limits, key=limits.get)
-        k, i = fast_cell()
-        text = (f"step {dt:.3g} s against {nominal:.3g} s, bounded by the {bound} ({KEYS[bound]}); the fastest "
-                f"fluid cell is at {self._where(frame, k, i)}, {self._width(width[k, i])} wide, theta_p "
-                f"{theta[k, i]:.3g}")
+        text = (f"step {dt:.3g} s against {nominal:.3g} s, bounded by the {bound} ({KEYS[bound]}); "
+                + self.fastest(frame, fast_cell(), width, theta))
         if dt < COLLAPSE_FLOOR * nominal:
             raise SimulationError(f"the proppant step collapsed: {text}", time=t + self.offset)
         self._report("collapsing step", t, text)
+
+    def fastest(self, frame, cell: tuple[int, int], width: np.ndarray, theta: np.ndarray) -> str:
+        """Where the fluid's largest Courant rate is, in the scene's units (``cell`` its (k, i))."""
+        k, i = cell
+        return (f"the fastest fluid cell is at {self._where(frame, k, i)}, {self._width(width[k, i])} wide, "
+                f"theta_p {theta[k, i]:.3g}")
 
     def summary(self) -> dict:
         return {"unphysical_states": "; ".join(self.found.values())}

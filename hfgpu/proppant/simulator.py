@@ -59,7 +59,7 @@ from ..records import GridFrame, ProppantSnapshot, SolidBalanceRecord
 from .config import Geometry, Port, ProppantSetup
 from .engine import make_engine
 from .fluid import CourantLimitExceeded, FluidNumerics, FluidSolver, FluidState, courant_rates
-from .health import Watch
+from .health import KEYS, Watch
 from .grid import StaggeredGrid
 from .injection import Injector, batch_solid_volume, initial_suspension, ports_to_cells
 from .parcels import Parcels
@@ -263,7 +263,7 @@ class ProppantSimulation:
                 self.solver.set_grid(self.grid)
                 self.engine.set_grid(self.grid)
             if not (dt > 0.0 and t0 + dt > t0):
-                raise SimulationError(f"zero-length time step (dt = {dt:g} s)", time=t0)
+                raise SimulationError(f"zero-length time step (dt = {dt:g} s)", time=t0 + self.watch.offset)
             self.engine.begin_step(self.fluid.u, self.fluid.v, self.fluid.p)
             if self.injector is not None:
                 self._inject(t0, t0 + dt)
@@ -284,8 +284,11 @@ class ProppantSimulation:
                 break
             dt *= min(0.5, 0.9 * self.numerics.c_max / info.courant)
         else:
+            where = self.watch.fastest(self.grid.frame, self._fastest_cell(), np.asarray(self.grid.width),
+                                       self.moments.volume_fraction)
             raise SimulationError(f"the fluid Courant number stayed above c_max = {self.numerics.c_max:g} "
-                                  f"after {self.numerics.max_step_retries} reductions of the step", time=t0)
+                                  f"after {self.numerics.max_step_retries} reductions of the step "
+                                  f"({KEYS['fluid Courant']}); {where}", time=t0 + self.watch.offset)
         self.engine.commit()
         self.outflow += loop.outflow
         self.fluid = trial
@@ -343,7 +346,7 @@ class ProppantSimulation:
             bad = ~np.isfinite(values)
             if bad.any():
                 cell = tuple(int(c) for c in np.argwhere(bad)[0])
-                raise SimulationError(f"non-finite fluid {name}", time=t, cell=cell)
+                raise SimulationError(f"non-finite fluid {name}", time=t + self.watch.offset, cell=cell)
 
     # -- records --------------------------------------------------------------------------------------
 

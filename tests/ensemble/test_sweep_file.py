@@ -91,8 +91,9 @@ def test_documented_example_parses(tmp_path):
     ("members = 0\n" + VARY + "values = [6e7]\n",
      "sweep key 'members': got 0; allowed: >= 1"),
     ("members = 4\n" + VARY + 'values = [6e7]\n[metrics]\nnames = ["propped_area", "height"]\n',
-     "sweep key 'metrics.names[1]': got 'height'; allowed: 'propped_area', 'created_area', 'propped_fraction', "
-     "'fracture_height', 'fracture_length', 'net_pressure_end', 'efficiency', 'screened_out'"),
+     "sweep key 'metrics.names[1]': got 'height'; allowed: 'propped_area', 'propped_area_in_place', "
+     "'created_area', 'propped_fraction', 'fracture_height', 'fracture_length', 'net_pressure_end', "
+     "'efficiency', 'screened_out'"),
 ])
 def test_bad_sweep_names_the_key(write_sweep, body, message):
     with pytest.raises(SweepError) as info:
