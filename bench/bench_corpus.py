@@ -9,6 +9,7 @@ fluid balance error (``balance_error``), the solid balance error |injected - in_
 
     python bench/bench_corpus.py [--scenes NAME ...] [--presets default fast balanced accurate] [--jobs 1]
                                  [--timeout 1800] [--out out/corpus] [--units field|SI] [--threads N]
+                                 [--pumping-scale F ...]
 
 NAME is a scene's file name without ``corpus_`` and ``.toml`` (``permian_slickwater_stage``). ``default`` runs
 the file as written; a preset runs it with ``[run] preset`` set (``hfgpu.edit_scene``; the edited scene is
@@ -24,6 +25,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import signal
 import statistics
 import subprocess
@@ -69,6 +71,20 @@ def scene_file(path: Path, preset: str, out: Path) -> Path:
     if preset == "default":
         return path
     out.write_text(edit_scene(load_scene(path.read_text()), {"run.preset": preset}).source)
+    return out
+
+
+def scaled(path: Path, factor: float, out: Path) -> Path:
+    """The scene with its end time and every stage's ``duration`` (written in minutes) times ``factor``, written
+    to ``out``: the same treatment pumped longer or shorter (``--pumping-scale``)."""
+    def times(match: re.Match) -> str:
+        return f'{match.group(1)} = "{float(match.group(2)) * factor:g} min"'
+
+    text, count = re.subn(r'\b(duration|end_time) = "([0-9.]+) min"', times, path.read_text())
+    stages = len(load_scene(path.read_text()).injection.schedule.stages)
+    if count != stages + 1:
+        raise SystemExit(f"--pumping-scale: {path.name} must give end_time and each stage's duration in min")
+    out.write_text(text)
     return out
 
 
@@ -180,6 +196,9 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=Path("out/corpus"), help="folder of the results files")
     ap.add_argument("--units", choices=("field", "SI"), default="field", help="of the areas (default field)")
     ap.add_argument("--threads", type=int, default=None, help="Taichi CPU threads per run (HFGPU_THREADS)")
+    ap.add_argument("--pumping-scale", type=float, nargs="+", default=None, metavar="F",
+                    help="run each scene with its end time and stage durations x F (e.g. 0.5 1 2: is wall time "
+                         "linear in the pumped time?)")
     args = ap.parse_args()
     unknown = [name for name in args.scenes if name not in scenes]
     if unknown:
@@ -187,6 +206,10 @@ def main() -> None:
     if args.jobs < 1 or args.timeout <= 0:
         ap.error(f"--jobs must be >= 1 (got {args.jobs}) and --timeout > 0 (got {args.timeout:g})")
     args.out.mkdir(parents=True, exist_ok=True)
+    if args.pumping_scale:
+        scenes = {f"{name}x{f:g}": scaled(scenes[name], f, args.out / f"{name}x{f:g}.toml")
+                  for name in args.scenes for f in args.pumping_scale}
+        args.scenes = list(scenes)
     runs = [(name, preset) for name in args.scenes for preset in args.presets]
     done: dict[tuple[str, str], Outcome] = {}
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:

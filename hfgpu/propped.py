@@ -54,7 +54,7 @@ GROUPS = ("suspended", "moving bed", "bed at rest", "bridged")
 #: Times [s] of the paper's probability plots (Fig. 16).
 PAPER_TIMES = (1260.0, 1800.0, 3600.0)
 #: Each headline propped-area number by the name every output carries, and its definition in words.
-DEFINITIONS = {"propped_area": "after closure (grains settled, [closure] layers packed layers)",
+DEFINITIONS = {"propped_area": "after closure (grains settled by [closure] settling)",
                "propped_area_in_place": "one packed grain layer, grains in place (no settling)"}
 
 

@@ -62,3 +62,12 @@ def test_figure_and_table_show_the_summary_number_and_name_it(tiny):
     line = next(x for x in table.splitlines() if "propped area (after closure)" in x)
     assert f" {format_number(summary['closure_propped_area'])} m^2 (" in line
     assert "created area (one face)" in table
+
+
+def test_proppant_balance_figure_is_in_the_summary_mass(tiny):
+    from hfgpu.io.plots import proppant_balance
+
+    scene, summary, results = tiny
+    line = proppant_balance(results).axes[0].get_lines()[0]   # injected
+    assert line.get_ydata()[-1] == pytest.approx(summary["proppant_injected"] * 2650.0, rel=1e-12)
+    assert proppant_balance(results).axes[0].get_ylabel() == "mass [kg]"

@@ -237,9 +237,7 @@ def pressure_history(results: Results, units: FigureUnits | None = None) -> Figu
     the end of pumping and the ISIP (hfgpu.io.summary.treatment_pressures) marked; the net pressure log-log
     while pumping only (a Nolte-Smith plot: slope 1/4 to 1/5 for a confined PKN-like fracture, negative for a
     radial or unconfined one; the shut-in decline is not a power law of the time since the start and stays on
-    the linear panels), positive values only, labelled at the decades (no minor tick labels)."""
-    from matplotlib.ticker import NullFormatter
-
+    the linear panels), positive values only, its ticks by :func:`_log_ticks`."""
     from .summary import pump_end, surface_history, treatment_pressures
 
     u = _units(results, units)
@@ -272,10 +270,24 @@ def pressure_history(results: Results, units: FigureUnits | None = None) -> Figu
     pumping = np.ones(t.shape, dtype=bool) if stop is None else t <= stop
     positive = pumping & (t > 0) & (net > 0)
     right.loglog(t[positive], net[positive])
-    right.xaxis.set_minor_formatter(NullFormatter())
-    right.yaxis.set_minor_formatter(NullFormatter())
+    for axis, values in ((right.xaxis, t[positive]), (right.yaxis, net[positive])):
+        _log_ticks(axis, values)
     right.set(xlabel="time [s]", ylabel=label, title="log-log while pumping (Nolte-Smith)")
     return fig
+
+
+def _log_ticks(axis, values: np.ndarray) -> None:
+    """Ticks of a log axis that do not overlap: labels at the decades and, when ``values`` span less than two
+    decades (so that few decades are labelled), also at 2 and 5 times them, as plain numbers ("200", "0.5")."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    span = np.log10(values.max() / values.min()) if values.size and values.min() > 0 else 0.0
+    plain = FuncFormatter(lambda v, _: f"{v:g}")
+    axis.set_major_locator(LogLocator(base=10.0))
+    axis.set_major_formatter(plain)
+    axis.set_minor_locator(LogLocator(base=10.0, subs=(2.0, 5.0) if span < 2.0 else (2.0, 3.0, 4.0, 5.0, 6.0,
+                                                                                        7.0, 8.0, 9.0)))
+    axis.set_minor_formatter(plain if span < 2.0 else NullFormatter())
 
 
 def volume_balance(results: Results, units: FigureUnits | None = None) -> Figure:

@@ -20,8 +20,8 @@ from hfgpu.units import convert
 from test_figures_trust import LAYERED
 
 FT, IN, PSI = convert(1.0, "m", "ft"), convert(1.0, "mm", "in"), convert(1.0, "MPa", "psi")
-SI_UNITS = re.compile(r"\[(m|mm|um|MPa|m\^2|m\^3|m/s)\]|x = [-\d.e]+ m ")
-FIELD_UNITS = re.compile(r"\[(ft|in|psi|ft\^2|ft\^3|bbl|ft/s)\]")
+SI_UNITS = re.compile(r"\[(m|mm|um|MPa|m\^2|m\^3|m/s|kg)\]|x = [-\d.e]+ m ")
+FIELD_UNITS = re.compile(r"\[(ft|in|psi|ft\^2|ft\^3|bbl|ft/s|lb)\]")
 COUPLED = (Path(__file__).resolve().parents[1] / "scenes" / "tiny_coupled.toml").read_text()
 
 
@@ -144,14 +144,14 @@ def test_coupled_field_figures(tmp_path):
     for name, fig in si.items():
         assert not any(FIELD_UNITS.search(label) for label in _labels(fig)), (name, _labels(fig))
     assert _labels(field["proppant_radius"])[-1] == "radius [in]" and _labels(si["proppant_radius"])[-1] == "radius [um]"
-    assert field["proppant_volume_balance"].axes[0].get_ylabel() == "volume [ft^3]"
+    assert field["proppant_volume_balance"].axes[0].get_ylabel() == "mass [lb]"   # as the summary: one density
     assert field["propped_area"].axes[0].get_ylabel() == "area [ft^2]"
     assert field["closure_maps"].axes[0].get_ylabel() == "depth z [ft]"
     assert "fluid speed [ft/s]" in _labels(field["proppant_streamlines"])
     # the solid balance in ft^3, the parcel positions in ft, the packed threshold in ft/s
     np.testing.assert_allclose(field["proppant_volume_balance"].axes[0].get_lines()[0].get_ydata(),
                                si["proppant_volume_balance"].axes[0].get_lines()[0].get_ydata()
-                               * convert(1.0, "m**3", "ft**3"), rtol=1e-12)
+                               * convert(1.0, "kg", "lb"), rtol=1e-12)
     np.testing.assert_allclose(field["proppant_radius"].axes[0].collections[0].get_offsets(),
                                si["proppant_radius"].axes[0].collections[0].get_offsets() * FT, rtol=1e-12)
     np.testing.assert_allclose(field["proppant_radius"].axes[0].get_xlim(),

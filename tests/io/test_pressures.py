@@ -64,16 +64,50 @@ def test_summary_shows_bhtp_isip_and_the_end_of_pumping(shut_in):
     assert "start [min]" in out and "Kozeny-Carman, independent of closure stress" in out
 
 
-def test_pressure_figure_logs_only_positive_pumping_net_pressure_without_minor_labels(shut_in):
+def _tick_labels(fig, ax) -> list[tuple[int, bool]]:
+    """(labels drawn, whether two of them overlap) of the x and the y axis of ``ax``, the figure drawn."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    frame = ax.get_window_extent(renderer)
+    out = []
+    for axis, (lo, hi), k in ((ax.xaxis, frame.intervalx, 0), (ax.yaxis, frame.intervaly, 1)):
+        boxes = [label.get_window_extent(renderer) for label in axis.get_ticklabels(which="both") if label.get_text()]
+        boxes = [b for b in boxes if lo - 1 <= (b.get_points()[:, k].mean()) <= hi + 1]   # the labels drawn
+        out.append((len(boxes), any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])))
+    return out
+
+
+def test_log_ticks_keep_labels_apart_where_the_defaults_overlap():
+    from matplotlib.figure import Figure
+
+    from hfgpu.io.plots import _log_ticks
+
+    t, net = np.geomspace(60.0, 540.0, 50), np.geomspace(300.0, 180.0, 50)   # a pumping period under a decade
+    figures = []
+    for fixed in (False, True):
+        fig = Figure(figsize=(14, 4), layout="constrained")
+        ax = fig.subplots(1, 3)[2]
+        ax.loglog(t, net)
+        if fixed:
+            _log_ticks(ax.xaxis, t)
+            _log_ticks(ax.yaxis, net)
+        figures.append(_tick_labels(fig, ax))
+    assert figures[0][0][1]                                   # matplotlib's own minor labels overlap here
+    assert all(count >= 2 and not overlap for count, overlap in figures[1])
+
+
+def test_pressure_figure_logs_only_positive_pumping_net_pressure_with_labels_apart(shut_in):
     _, results = shut_in
     fig = pressure_history(results)
     left, middle, right = fig.axes
     t, net = right.get_lines()[0].get_xdata(), right.get_lines()[0].get_ydata()
     assert t.size > 2 and t.max() <= 40.0 and np.all(net > 0.0)
     assert len(left.get_lines()[0].get_xdata()) == results.fracture_balance["time"].size   # shut-in: linear panel
-    fig.canvas.draw()
-    for axis in (right.xaxis, right.yaxis):
-        assert all(not label.get_text() for label in axis.get_minorticklabels())
+    for count, overlap in _tick_labels(fig, right):
+        assert count >= 2 and not overlap                                     # labelled, no two labels overlap
     assert any(line.get_label().startswith("ISIP ") for line in middle.get_lines())
     assert middle.get_ylabel() == "treating pressure [psi]"
 
