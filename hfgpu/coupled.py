@@ -51,6 +51,7 @@ from .coupling import FractureHistory, bridging_risk, proppant_frame
 from .errors import SceneError
 from .fracture.mesh import injection_cell_centre
 from .fracture.simulator import simulate as simulate_fracture
+from .io.progress import shifted
 from .proppant.config import Geometry, Port
 from .proppant.simulator import ProppantSimulation, warn_screen_out
 from .records import GridFrame, ProppantSnapshot, SolidBalanceRecord
@@ -330,7 +331,7 @@ def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None =
 
     if hasattr(progress, "phase"):  # hfgpu.io.progress.Progress: a bar of its own for the proppant phase
         progress.phase("proppant", start)
-    proppant = sim.run(shift, None if progress is None else (lambda t: progress(t + start)),
+    proppant = sim.run(shift, None if progress is None else shifted(progress, start),
                        checkpoint=checkpoint and checkpoint.within(start, wrap),
                        resume=resume["proppant"] if phase == "proppant" else None)
     warn_screen_out(proppant, scene.proppant.params.theta_cp, offset=start)

@@ -166,12 +166,13 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
 
 def _checked(bar: Any, stop: Any) -> Callable[[float], None]:
     """The progress callback, first raising a stop signal whose own raise was lost (hfgpu.interrupts): the
-    engines call it after every step. Keeps the bar's ``phase`` (the coupled run's second bar)."""
+    engines call it after every step. Keeps the bar's ``phase`` (the coupled run's second bar), ``note`` and
+    ``limit`` (hfgpu.io.progress)."""
     def progress(t: float) -> None:
         stop.check()
         bar(t)
 
-    progress.phase = bar.phase  # type: ignore[attr-defined]
+    progress.phase, progress.note, progress.limit = bar.phase, bar.note, bar.limit  # type: ignore[attr-defined]
     return progress
 
 

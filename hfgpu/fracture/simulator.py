@@ -70,6 +70,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import SceneError, SimulationError
+from ..io.progress import limit as show_limit
 from ..records import BalanceRecord, FractureSnapshot, GridFrame
 from ..threads import blas_threads
 from .coarsen import coarse_front, coarsen
@@ -793,6 +794,7 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
             sink.fracture_balance(record)
             if progress is not None:
                 progress(eng.t)
+                show_limit(progress, taken, "snapshot interval" if taken == step == remaining else "front advance")
             while k < len(outputs) and (outputs[k] < eng.t or _landed(outputs[k], eng.t)):
                 view = eng.now() if _landed(outputs[k], eng.t) else eng.between(outputs[k])
                 sink.fracture_snapshot(eng.snapshot(view, outputs[k]))

@@ -55,6 +55,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import SimulationError
+from ..io.progress import limit as show_limit, note
 from ..records import GridFrame, ProppantSnapshot, SolidBalanceRecord
 from .config import Geometry, Port, ProppantSetup
 from .engine import make_engine
@@ -389,6 +390,8 @@ class ProppantSimulation:
             if self.time >= end - eps:
                 break
             targets = [end, next_out] + [b for b in breaks if b > self.time + eps]
+            if self.steps == 0 and self.engine.name == "taichi":
+                note(progress, "compiling kernels")
             info = self.step(limit=min(targets) - self.time)
             max_residual = max(max_residual, info.continuity_residual)
             sink.proppant_balance(self.balance())
@@ -396,6 +399,7 @@ class ProppantSimulation:
                 on_step(info)
             if progress is not None:
                 progress(self.time)
+                show_limit(progress, info.dt, self.limited_by)
             if checkpoint is not None and checkpoint.due(self.time):
                 checkpoint.save(self.time, {"simulation": self.state(), "next_out": next_out,
                                             "max_residual": max_residual})
