@@ -1,8 +1,8 @@
 """The ``hfgpu`` command: run a scene, plot or export a results file, check a scene, run an
-ensemble of scenes (docs/cli.md).
+ensemble of scenes, re-print a results file's summary (docs/cli.md).
 
 Exit codes: 0 success; 2 bad input or a failed run (an :class:`HfgpuError`, one line on stderr, no
-traceback; argparse usage errors too); 128 + the signal's number when interrupted: 130 Ctrl-C (SIGINT), 143
+traceback; argparse usage errors and files or folders that cannot be written (OSError) too); 128 + the signal's number when interrupted: 130 Ctrl-C (SIGINT), 143
 SIGTERM, 129 SIGHUP (the results file then says "interrupted" and resumes with --resume).
 """
 
@@ -26,7 +26,8 @@ def _parser() -> argparse.ArgumentParser:
 
     run = commands.add_parser("run", help="run a scene and write a results file")
     run.add_argument("scene", type=Path, help="scene file (TOML)")
-    run.add_argument("--out", type=Path, required=True, help="results file to write (HDF5, replaced)")
+    run.add_argument("--out", type=Path, required=True, help="results file to write (HDF5, replaced; its folder is "
+                     "created; refused while another run writes it)")
     run.add_argument("--resume", action="store_true", help="continue the killed run in --out from its last "
                      "checkpoint (the scene must be the same); a complete file is left alone")
     run.add_argument("--rrd", type=Path, help="also save a Rerun recording to this .rrd file")
@@ -42,6 +43,9 @@ def _parser() -> argparse.ArgumentParser:
                       "folder written by 'hfgpu sweep'")
     plot.add_argument("--out", type=Path, help="folder for the figures (default: <results>_plots; a sweep "
                       "folder: <folder>/plots)")
+
+    summary = commands.add_parser("summary", help="print the run summary of a results file again")
+    summary.add_argument("results", type=Path, help="results file (HDF5) written by 'hfgpu run'")
 
     check = commands.add_parser("check", help="validate a scene file and describe it")
     check.add_argument("scene", type=Path, help="scene file (TOML)")
@@ -72,8 +76,19 @@ def _run(args: argparse.Namespace) -> None:
 
     scene = validate(args.scene)  # what check reports: errors, then the same warnings
     print_warnings(scene)
+    args.out.parent.mkdir(parents=True, exist_ok=True)  # as plot and export create theirs
     run(scene, args.out, progress=not args.no_progress, rrd=args.rrd, view=args.view,
         connect=args.connect, resume=args.resume, viewer_required=args.viewer_required)
+
+
+def _warn_unfinished(path: Path) -> None:
+    """A warning line on stderr when the results file ``path`` holds a run that did not complete."""
+    from .io.results import open_results
+
+    status = open_results(path).status
+    if status != "complete":
+        print(f"hfgpu: warning: {path}: the run is not complete (status \"{status}\"); what follows shows it "
+              "as far as it got", file=sys.stderr, flush=True)
 
 
 def _plot(args: argparse.Namespace) -> None:
@@ -85,6 +100,7 @@ def _plot(args: argparse.Namespace) -> None:
         for path in plot_ensemble(args.results, args.out or args.results / "plots"):
             print(path)
         return
+    _warn_unfinished(args.results)
     folder = args.out or args.results.with_name(args.results.stem + "_plots")
     for path in plot_results(args.results, folder):
         print(path)
@@ -93,18 +109,32 @@ def _plot(args: argparse.Namespace) -> None:
 def _export(args: argparse.Namespace) -> None:
     from .io.export import export
 
+    _warn_unfinished(args.results)
     for path in export(args.results, args.format, args.out, args.units):
         print(path)
 
 
 def _sweep(args: argparse.Namespace) -> None:
     from .ensemble import sweep
+    from .ensemble.execute import percentile_lines
+    from .ensemble.sweep_file import load_sweep
+    from .scene import unit_system
 
     rows = sweep(args.sweep, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
                  progress=not args.no_progress)
     complete = sum(row["status"] == "complete" for row in rows)
+    spec = load_sweep(args.sweep)
+    system = unit_system(spec.scene_data)
+    print(f"metrics over the {complete} complete members ({system} units):")
+    print("\n".join(percentile_lines(rows, list(spec.metrics), system)))
     print(f"{args.out}: {complete} of {len(rows)} members complete; summary.csv, ensemble.h5, members/ "
           f"(figures: hfgpu plot {args.out})")
+
+
+def _summary(args: argparse.Namespace) -> None:
+    from . import summary
+
+    print(summary(args.results), flush=True)
 
 
 def _check(args: argparse.Namespace) -> None:
@@ -121,16 +151,29 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the console script; returns the exit code."""
     args = _parser().parse_args(argv)
     try:
-        {"run": _run, "plot": _plot, "check": _check, "export": _export, "sweep": _sweep}[args.command](args)
+        {"run": _run, "plot": _plot, "check": _check, "export": _export, "sweep": _sweep,
+         "summary": _summary}[args.command](args)
     except HfgpuError as exc:  # one line per error (a scene's errors come together), even where a value holds breaks
         for error in getattr(exc, "errors", None) or [exc]:
             print(f"hfgpu {args.command}: error: {' '.join(str(error).splitlines())}", file=sys.stderr)
         return 2
+    except OSError as exc:  # a folder or file the user cannot write or read: what and where, not a traceback
+        where = f"'{exc.filename}': " if exc.filename else ""
+        print(f"hfgpu {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt as exc:
         number = signal_number(exc)
+        if args.command in ("run", "sweep"):
+            print(f"hfgpu {args.command}: {_resume_hint(args)}", file=sys.stderr)
         print(f"hfgpu {args.command}: interrupted ({signal.Signals(number).name})", file=sys.stderr)
         return 128 + number
     return 0
+
+
+def _resume_hint(args: argparse.Namespace) -> str:
+    """How to continue an interrupted ``run`` or ``sweep``."""
+    given = args.scene if args.command == "run" else args.sweep
+    return f"what is done is kept; continue with: hfgpu {args.command} {given} --out {args.out} --resume"
 
 
 if __name__ == "__main__":

@@ -51,6 +51,10 @@ class FractureSnapshot:
     opening_time: np.ndarray
     extras: dict[str, np.ndarray] = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        return (f"FractureSnapshot(time={self.time:.6g} s, {self.frame}, "
+                f"{_shapes({name: getattr(self, name) for name in _FRACTURE_ARRAYS} | self.extras)})")
+
 
 @dataclass(frozen=True)
 class BalanceRecord:
@@ -89,6 +93,10 @@ class ProppantSnapshot:
     parcels: dict[str, np.ndarray]
     grid: dict[str, np.ndarray]
 
+    def __repr__(self) -> str:
+        return (f"ProppantSnapshot(time={self.time:.6g} s, {self.frame}, parcels: {_shapes(self.parcels)}, "
+                f"grid: {_shapes(self.grid)})")
+
 
 @dataclass(frozen=True)
 class SolidBalanceRecord:
@@ -102,6 +110,16 @@ class SolidBalanceRecord:
     in_domain: float
     outflow: float
     screened_out: float = 0.0
+
+
+_FRACTURE_ARRAYS = ("width", "pressure", "leakoff_rate", "opening_time")
+
+
+def _shapes(arrays: dict[str, np.ndarray]) -> str:
+    """``name(shape)`` of each array (``name=value`` of a scalar), comma separated: a snapshot's repr without its
+    arrays' values."""
+    return ", ".join(f"{name}={float(array):.6g}" if np.ndim(array) == 0 else f"{name}{tuple(np.shape(array))}"
+                     for name, array in arrays.items())
 
 
 class MemorySink:

@@ -112,6 +112,33 @@ def sweep(sweep_file: str | Path, out: str | Path, *, workers: int | None = None
     return ordered
 
 
+#: The display kind (hfgpu.units.DISPLAY_UNITS) of each SI metric unit (hfgpu.ensemble.metrics.UNITS).
+METRIC_KINDS = {"m^2": "area", "m": "length", "Pa": "pressure"}
+
+
+def percentile_lines(rows: list[dict[str, Any]], names: list[str], system: str) -> list[str]:
+    """One line per metric, "name [unit]  P10 ...  P50 ...  P90 ..." over the complete members
+    (:func:`hfgpu.ensemble.summary.percentiles`), in ``system``'s display units (the base scene's
+    ``[output] units``); ratios and flags as they are."""
+    from ..io.display_units import FigureUnits
+    from .metrics import UNITS
+    from .summary import percentiles
+
+    units, lines = FigureUnits(system), []
+    for name in names:
+        kind = METRIC_KINDS.get(UNITS.get(name, "-"))
+        values = percentiles(rows, name)
+        shown, label = (units(kind, values), units.label(kind)) if kind else (values, "-")
+        lines.append((f"  {name + ' [' + label + ']':<32}" + "  ".join(f"P{level} {_number(v):<10}" for level, v
+                                                                       in zip((10, 50, 90), shown))).rstrip())
+    return lines
+
+
+def _number(value: float) -> str:
+    """Four significant digits, without an exponent below 1e7 (18200, not 1.82e+04)."""
+    return f"{value:.0f}" if 1e4 <= abs(value) < 1e7 else f"{value:.4g}"
+
+
 def _complete_row(member: Member, path: Path, names: list[str]) -> dict[str, Any] | None:
     """The row of a member whose file is complete and holds its scene; None when it must run."""
     from ..io.results import open_results

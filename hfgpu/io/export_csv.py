@@ -5,7 +5,8 @@
 ``sauter_diameter``; ``<stem>_pressure.csv`` beside it: one row per snapshot (the fracture's, or the proppant
 grid's for a proppant-only run), columns ``time``, ``pressure_injection`` (the cell nearest the injection
 point, NaN when the scene names none), ``pressure_mean`` and ``pressure_max`` (over the open cells). Each
-header names the unit, e.g. ``conductivity [md ft]``, in SI or field units.
+header names the unit, e.g. ``conductivity [md ft]``, in SI or field units; a run that did not complete adds a
+first line ``# hfgpu: the run is not complete (status "...")``.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..closure.display import in_units, unit_label
-from .export_common import injection_point
+from .export_common import injection_point, round_off, status_note
 
 MAP_COLUMNS = ("x", "depth", "propped", "propped_width", "conductivity", "permeability", "closure_stress",
                "sauter_diameter")
@@ -32,16 +33,18 @@ def write_csv(results: Any, closure: Any, out: Path, system: str) -> list[Path]:
     nz, nx = fields["propped_width"].shape
     x, z = closure.frame.centres(nz, nx)
     grid_x, grid_z = np.meshgrid(x, z)
-    columns = {"x": grid_x, "depth": grid_z, **fields}
+    columns = {"x": round_off(grid_x, float(np.max(np.abs(grid_z), initial=1.0))), "depth": grid_z, **fields}
     table = np.column_stack([np.ravel(columns[n]) if n == "propped" else np.ravel(in_units(n, columns[n], system))
                              for n in MAP_COLUMNS])
-    np.savetxt(out, table, delimiter=",", header=_header(MAP_COLUMNS, system), comments="", fmt="%.10g")
+    note = status_note(results)
+    first = f"# {note}\n" if note else ""   # a comment line (pandas: comment="#") only for a run that did not complete
+    np.savetxt(out, table, delimiter=",", header=first + _header(MAP_COLUMNS, system), comments="", fmt="%.10g")
     pressure = out.with_name(out.stem + "_pressure.csv")
     history = pressure_history(results)
     table = np.column_stack([history[0]] + [in_units("pressure", column, system) for column in history[1:]])
     unit = unit_label("pressure", system)
     header = ",".join(["time [s]"] + [f"pressure_{n} [{unit}]" for n in ("injection", "mean", "max")])
-    np.savetxt(pressure, table.reshape(-1, 4), delimiter=",", header=header, comments="", fmt="%.10g")
+    np.savetxt(pressure, table.reshape(-1, 4), delimiter=",", header=first + header, comments="", fmt="%.10g")
     return [out, pressure]
 
 

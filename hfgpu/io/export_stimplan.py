@@ -35,14 +35,14 @@ from typing import Any
 import numpy as np
 
 from ..units import convert
-from .export_common import injection_point
+from .export_common import injection_point, round_off, status_note
 
 #: unit system: (length, width, conductivity as StimPlan spells them, and as pint does).
 UNITS = {"SI": ("m", "cm", "md-m", "md*m"), "field": ("ft", "in", "md-ft", "md*ft")}
 
 
 def _row(values: np.ndarray) -> str:
-    return "[" + " ".join(f"{v:.8g}" for v in values) + "]"
+    return "[" + " ".join(f"{v:.8g}" for v in round_off(values)) + "]"
 
 
 def write_stimplan(results: Any, closure: Any, out: Path, system: str) -> list[Path]:
@@ -58,7 +58,8 @@ def write_stimplan(results: Any, closure: Any, out: Path, system: str) -> list[P
                   ("CONDUCTIVITY", conductivity_unit, fields["conductivity"] * convert(1.0, "m**3", conductivity_pint)),
                   ("PERMEABILITY", "md", fields["permeability"] * convert(1.0, "m**2", "md")))
     minutes = closure.scalars["time"] / 60.0
-    lines = ['<?xml version="1.0" ?>', "<contours>",
+    note = status_note(results)
+    lines = ['<?xml version="1.0" ?>', *([f"<!-- {note} -->"] if note else []), "<contours>",
              f'    <grid xCount="{nx}" yCount="{nz}" uom="{length}" cs="tvd" frac="1">',
              f"        <xs>{_row((x - x_well) * to_length)}</xs>",
              f"        <ys>{_row(z[::-1] * to_length)}</ys>",

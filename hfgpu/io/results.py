@@ -26,6 +26,10 @@ Checkpoints (:meth:`ResultsWriter.write_checkpoint`, :mod:`hfgpu.io.checkpoint`)
 removal of the old one and the move leaves the complete new one, which :meth:`ResultsWriter.reopen` takes.
 The file keeps its free space across openings (HDF5 persistent free-space manager), so replacing a checkpoint
 reuses the old one's space instead of growing the file.
+
+One writer at a time: a writer holds ``<file>.lock`` (its process id) from its creation or :meth:`ResultsWriter.reopen`
+to :meth:`ResultsWriter.close`; another process's writer to that file is refused before it touches it
+(:func:`acquire_lock`).
 """
 
 from __future__ import annotations
@@ -205,6 +209,70 @@ def _unshared(path: Path) -> bool:
         os.close(fd)
 
 
+LOCK = ".lock"
+
+
+def acquire_lock(path: Path) -> Path:
+    """Take the advisory lock of the results file ``path``: the file ``<path>.lock`` holding this process's id,
+    created exclusively. A lock whose process is dead (or is this one) is stale and taken over; one held by a
+    live process is an :class:`HfgpuError` raised before any work, so two runs never mix one file."""
+    lock = path.with_name(path.name + LOCK)
+    for _ in range(2):
+        try:
+            fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+        except FileExistsError:
+            holder = _lock_holder(lock)
+            if holder is not None:
+                raise HfgpuError(f"'{path}' is being written by another run (process {holder}, lock file "
+                                 f"'{lock}'); wait for it to end or choose another results file") from None
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(lock)
+            continue
+        except OSError:  # a folder where no lock can be created: the results file itself will say why
+            return lock
+        with os.fdopen(fd, "w") as f:
+            f.write(str(os.getpid()))
+        return lock
+    raise HfgpuError(f"'{path}' is being written by another run (lock file '{lock}')")
+
+
+def release_lock(path: Path) -> None:
+    """Remove the lock of ``path`` when this process holds it."""
+    lock = path.with_name(path.name + LOCK)
+    with contextlib.suppress(OSError, ValueError):
+        if int(lock.read_text()) == os.getpid():
+            lock.unlink()
+
+
+def _lock_holder(lock: Path) -> int | None:
+    """The live process (not this one) holding ``lock``; None when the lock is stale."""
+    try:
+        text = lock.read_text().strip()
+    except FileNotFoundError:
+        return None
+    if not text.isdigit():  # being written by its creator now, or garbage left by a crash long ago
+        return -1 if _age(lock) < 5.0 else None
+    pid = int(text)
+    if pid == os.getpid():
+        return None
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return None
+    except PermissionError:  # alive, another user's
+        return pid
+    return pid
+
+
+def _age(path: Path) -> float:
+    import time
+
+    try:
+        return time.time() - path.stat().st_mtime
+    except FileNotFoundError:
+        return 0.0
+
+
 class ResultsWriter:
     """Output sink writing an HDF5 results file (the sink methods of hfgpu/records.py).
 
@@ -216,6 +284,7 @@ class ResultsWriter:
     def __init__(self, path: str | Path, scene: Any):
         from .. import __version__
 
+        acquire_lock(Path(path))
         self._start(Path(path), {"fracture": 0, "proppant": 0}, 0.0)
         try:
             with _edit(self.path, create=True) as f:
@@ -223,6 +292,7 @@ class ResultsWriter:
                                status="running")
                 _dataset(f, "scene", np.array(getattr(scene, "source", "") or "", dtype=h5py.string_dtype()))
         except OSError as exc:
+            release_lock(self.path)
             raise HfgpuError(f"cannot create the results file '{self.path}': {exc}") from None
 
     def _start(self, path: Path, counts: dict[str, int], last_time: float) -> None:
@@ -240,6 +310,19 @@ class ResultsWriter:
         to "running"; ``state`` is the tree the simulator saved at simulated time ``time`` [s]. Raises
         :class:`HfgpuError` for a file that is not a results file or holds no checkpoint."""
         path = Path(path)
+        acquire_lock(path)
+        try:
+            time, state, counts = cls._rewind(path)
+        except BaseException:
+            release_lock(path)
+            raise
+        writer = cls.__new__(cls)
+        writer._start(path, counts, time)
+        return writer, time, state
+
+    @staticmethod
+    def _rewind(path: Path) -> tuple[float, dict, dict[str, int]]:
+        """The checkpoint's (time, state, snapshot counts) of ``path``, the file cut back to it (see :meth:`reopen`)."""
         with contextlib.ExitStack() as stack:
             try:
                 f = stack.enter_context(_edit(path))
@@ -265,9 +348,7 @@ class ResultsWriter:
             f.attrs["status"] = "running"
             time, state = float(a["time"]), read_tree(group["state"])
             f.flush()
-        writer = cls.__new__(cls)
-        writer._start(path, counts, time)
-        return writer, time, state
+        return time, state, counts
 
     # sink methods ------------------------------------------------------------------------------
 
@@ -346,7 +427,10 @@ class ResultsWriter:
             f.require_group("summary").attrs.update(values)
             f.attrs["status"] = status
 
-        self._file.apply_last(write)
+        try:
+            self._file.apply_last(write)
+        finally:
+            release_lock(self.path)
 
     def write_closure(self, frame: GridFrame, fields: dict[str, np.ndarray], attrs: dict[str, Any]) -> None:
         """Replace ``/closure`` (grid ``fields`` on ``frame``, scalar ``attrs``) and add ``attrs`` prefixed
@@ -362,7 +446,11 @@ class ResultsWriter:
                 _dataset(group, name, array).attrs["kind"] = "grid"
             f.require_group("summary").attrs.update({f"closure_{k}": v for k, v in attrs.items()})
 
-        self._file.apply_last(write)
+        acquire_lock(self.path)
+        try:
+            self._file.apply_last(write)
+        finally:
+            release_lock(self.path)
 
     def fail(self, message: str, summary: dict[str, Any] | None = None) -> None:
         """Close with status "failed: <message>"."""
