@@ -10,6 +10,7 @@ gallon of clean fluid, ``md`` is the millidarcy (conductivities in "md*ft").
 from __future__ import annotations
 
 import functools
+import pickle
 import re
 import warnings
 
@@ -72,12 +73,14 @@ FIELD_UNITS = {
 def registry() -> pint.UnitRegistry:
     """The one unit registry of hfgpu, with oilfield units added. Pint's parsed definitions are cached on disk
     (``cache_folder=":auto:"``, the user cache folder): a process then builds the registry in ~0.04 s instead of
-    ~0.25 s; where that folder cannot be written the registry is built without it."""
+    ~0.25 s. Where that folder cannot be written, or a cache file cannot be read (16 processes started at once on a
+    fresh machine read each other's half-written files: EOFError, UnicodeDecodeError in flexcache's unpickling),
+    the registry is built without it."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
             ureg = pint.UnitRegistry(on_redefinition="warn", cache_folder=":auto:")
-        except OSError:
+        except (OSError, EOFError, ValueError, pickle.UnpicklingError):
             ureg = pint.UnitRegistry(on_redefinition="warn")
         ureg.define("bbl = 42 * gallon = oilfield_barrel")
         ureg.define("bpm = bbl / minute")
