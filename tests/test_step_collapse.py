@@ -12,6 +12,8 @@ import numpy as np
 import pytest
 
 from hfgpu.errors import SimulationError
+from hfgpu.io import plots
+from hfgpu.io.plots import status_banner
 from hfgpu.io.results import open_results
 from hfgpu.proppant.health import COLLAPSE_FLOOR, Watch
 from hfgpu.records import GridFrame
@@ -37,11 +39,16 @@ def test_collapsed_step_stops_the_run_and_resume_with_a_changed_key_finishes_it(
     kept = open_results(out)
     assert kept.status.startswith("failed")
     assert len(kept.fracture_snapshots) > 0
+    banner = status_banner(kept)
+    assert banner.startswith("NOT COMPLETE: failed: the proppant step collapsed")
+    figures = plots.figures(kept)
+    assert figures and all(any(t.get_text() == banner for t in fig.texts) for fig in figures.values())
     scene.write_text(TINY.replace('dt_max = "0.25 s"', 'dt_max = "0.25 s"\nc_max = 0.5'))
     resumed = _hfgpu("run", str(scene), "--out", str(out), "--resume")
     assert resumed.returncode == 0, resumed.stderr
     done = open_results(out)
     assert done.status == "complete"
+    assert status_banner(done) is None
     assert done.summary["proppant_time"] == pytest.approx(40.0)
 
 

@@ -593,8 +593,24 @@ def _closure(results: Results):
         return None
 
 
+def status_banner(results: Results) -> str | None:
+    """What a reader must know before trusting the figures of ``results``: a run that did not complete (its
+    status) or unphysical states found during it (their kinds and first times, hfgpu.proppant.health); None when
+    neither."""
+    lines = []
+    if results.status != "complete":
+        lines.append(f"NOT COMPLETE: {' '.join(str(results.status).split())[:110]}")
+    summary = results.summary or {}
+    found = summary.get("proppant_unphysical_states") or summary.get("unphysical_states") or ""
+    if found:
+        kinds = [item.split(":")[0] for item in str(found).split("; ")]
+        lines.append("unphysical states: " + "; ".join(kinds))
+    return "\n".join(lines) or None
+
+
 def figures(results: Results, units: FigureUnits | None = None) -> dict[str, Figure]:
-    """Every figure the results support, by file stem, in ``units`` (default: the results' ``[output] units``)."""
+    """Every figure the results support, by file stem, in ``units`` (default: the results' ``[output] units``);
+    each carries :func:`status_banner` in red at its top left where there is one."""
     out: dict[str, Figure] = {}
     layers = layer_boundaries(results)
     u = _units(results, units)
@@ -622,6 +638,10 @@ def figures(results: Results, units: FigureUnits | None = None) -> dict[str, Fig
                    proppant_streamlines=streamlines(results.proppant_snapshots[-1], layers, u),
                    proppant_speed_probability=speed_probability(results, units=u),
                    propped_area=propped_area(results, units=u))
+    banner = status_banner(results)
+    if banner is not None:
+        for fig in out.values():
+            fig.text(0.005, 0.995, banner, ha="left", va="top", color="red", fontsize=8)
     return out
 
 
