@@ -19,6 +19,8 @@ Warnings (the scene is valid, but likely not what was meant):
 * a layer boundary the fracture grid cannot put on a cell face (:func:`hfgpu.fracture.mesh.fit_layers`: the faces
   are placed on the boundary nearest the injection depth, dz in use; a boundary a whole number of cells from it is
   on a face too): one warning per such boundary, naming the cell height that puts every boundary on a face;
+* what the fracture's closed-form scales predict (:mod:`hfgpu.estimate`): a grain too large for the expected
+  opening at the perforation, a fracture of fewer than 3 cells' radius, leak-off taking nearly all the fluid;
 * fewer than :data:`MIN_CELLS_ACROSS` cells (dz in use) across a layer the fracture enters: the layer at the
   injection depth and the layers just above and below it (the outermost layers, which extend to +-infinity, are
   not counted).
@@ -31,6 +33,8 @@ from pathlib import Path
 from typing import TextIO
 
 from .errors import SceneError
+from .estimate import report as expected_report
+from .estimate import warnings as expected_warnings
 from .scene import Scene, load_scene
 from .scene_reader import raise_all
 from .units import display_unit, format_number, in_display_units
@@ -80,6 +84,7 @@ def review(scene: Scene) -> list[str]:
         found += _schedule(scene, system)
     if scene.rock is not None and scene.rock.layers and scene.injection is not None and scene.has("fracture"):
         found += _layers(scene, system)
+    found += expected_warnings(scene, system)
     return found
 
 
@@ -206,4 +211,7 @@ def describe(scene: Scene, name: str) -> str:
              knob_report(scene, system)]
     if scene.injection is not None:
         lines.append(schedule_table(scene, system))
+    expected = expected_report(scene, system)
+    if expected:
+        lines.append(expected)
     return "\n".join(lines)

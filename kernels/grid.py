@@ -11,7 +11,7 @@ from hfgpu.kernels.layout import (
     P_DAMPING, P_DAMPING_THRESHOLD, P_DX, P_DZ, P_EPSILON, P_FRICTION_FRACTION, P_RESTITUTION, P_STRESS_BETA,
     P_STRESS_P, P_THETA_CP, PRESSURE, SAUTER, TAU, THETA, VARIANCE, WIDTH)
 from hfgpu.kernels.runtime import ti
-from hfgpu.kernels.stencil import cell_flags
+from hfgpu.kernels.stencil import cell_flags, free_grains
 
 SQRT_3PI = 3.0699801238394655  # sqrt(3 pi)
 
@@ -174,7 +174,8 @@ def finish_faces(C: ti.template(), F: ti.template(), D: ti.template(), copies: t
             force = force / volume
             beta = beta / volume
             ka, ia, _ = face_sides(F, k, i, axis)
-            load = 0.5 * (C[THETA, ka, ia] * C[WIDTH, ka, ia] + C[THETA, k, i] * C[WIDTH, k, i])
+            load = 0.5 * (free_grains(C[THETA, ka, ia], PR) * C[THETA, ka, ia] * C[WIDTH, ka, ia]
+                          + free_grains(C[THETA, k, i], PR) * C[THETA, k, i] * C[WIDTH, k, i])
             reaction = -(load / F[F_WIDTH, k, i]) * F[F_DP, k, i]
         else:
             force = 0.0

@@ -39,7 +39,7 @@ from hfgpu.kernels.layout import (
 from hfgpu.kernels.momentum import wall_friction_factor
 from hfgpu.kernels.runtime import ti
 from hfgpu.kernels.stencil import (
-    INTERIOR, LOOSE, NO_RUN, QUIET, bilinear, block_range, blocked, closed, flush, owner,
+    INTERIOR, LOOSE, NO_RUN, QUIET, bilinear, block_range, blocked, closed, flush, free_grains, owner,
     owner_flags, run_sum, sample, volume_weights)
 
 PI = 3.141592653589793
@@ -130,18 +130,21 @@ def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template()
 
 @ti.func
 def seen_at(sx: ti.f64, sz: ti.f64, interior: ti.template(), C: ti.template(), XF: ti.template(),
-            ZF: ti.template()):
+            ZF: ti.template(), PR: ti.template()):
     """The SEEN grid values at cell coordinates (sx, sz) (Eq. 40-41 with x-/z-face weights; cell fields with
-    cell weights; the width of the own cell); ``interior``: the own cell is INTERIOR (bilinear)."""
+    cell weights; the width of the own cell); ``interior``: the own cell is INTERIOR (bilinear). The pressure
+    gradient is 0 where the own cell is in a contact network (particle_ops_numpy.gather)."""
     kx, ix, wx = bilinear(sx + 0.5, sz, XF, F_MASK, interior)
     kz, iz, wz = bilinear(sx, sz + 0.5, ZF, F_MASK, interior)
     kc, ic, wc = bilinear(sx, sz, C, CELL, interior)
     k, i = owner(sx, sz)
     own = 0.0
+    free = 1.0
     if k >= 0 and k < C.shape[1] and i >= 0 and i < C.shape[2]:
         own = C[WIDTH, k, i]
+        free = free_grains(C[THETA, k, i], PR)
     return ti.Vector([sample(XF, F_VELOCITY, kx, ix, wx, interior), sample(ZF, F_VELOCITY, kz, iz, wz, interior),
-                      sample(XF, F_DP, kx, ix, wx, interior), sample(ZF, F_DP, kz, iz, wz, interior),
+                      free * sample(XF, F_DP, kx, ix, wx, interior), free * sample(ZF, F_DP, kz, iz, wz, interior),
                       sample(XF, F_DTAU, kx, ix, wx, interior), sample(ZF, F_DTAU, kz, iz, wz, interior),
                       sample(C, THETA, kc, ic, wc, interior), sample(C, MEAN_U, kc, ic, wc, interior),
                       sample(C, MEAN_V, kc, ic, wc, interior), sample(C, DAMPING, kc, ic, wc, interior), own],
@@ -172,9 +175,9 @@ def gather_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i32,
                 sz = szs[l]
                 s = ti.Vector.zero(ti.f64, SEEN)
                 if owner_flags(sx, sz, FLAGS) & INTERIOR:
-                    s = seen_at(sx, sz, True, C, XF, ZF)
+                    s = seen_at(sx, sz, True, C, XF, ZF, PR)
                 else:
-                    s = seen_at(sx, sz, False, C, XF, ZF)
+                    s = seen_at(sx, sz, False, C, XF, ZF, PR)
                 for j in ti.static(range(SEEN)):
                     W[j, p] = s[j]
                 if first:

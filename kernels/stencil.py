@@ -6,7 +6,7 @@ as cell coordinates s = (x - x0) / dx (the expression of hfgpu.proppant.interpol
 The NumPy references are in hfgpu.proppant.interpolation and hfgpu.proppant.particle_ops_numpy.
 """
 
-from hfgpu.kernels.layout import CELL, THETA, WIDTH
+from hfgpu.kernels.layout import CELL, P_FRICTION_FRACTION, THETA, WIDTH
 from hfgpu.kernels.runtime import ti
 
 CHUNK = 64  # parcels per block of the atomic (GPU) deposits
@@ -47,6 +47,13 @@ def bilinear(sx: ti.f64, sz: ti.f64, grid: ti.template(), mask: ti.template(), i
         else:
             w = ti.Vector([0.0, 0.0, 0.0, 0.0], dt=ti.f64)
     return k0, i0, w
+
+
+@ti.func
+def free_grains(theta: ti.f64, PR: ti.template()) -> ti.f64:
+    """1 where a cell's grains take the fluid's pressure gradient themselves (theta_p < friction_volume_fraction),
+    0 in a contact network, whose skeleton carries it (particle_ops_numpy.free_grains)."""
+    return 1.0 if theta < PR[P_FRICTION_FRACTION] else 0.0
 
 
 @ti.func

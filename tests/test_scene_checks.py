@@ -91,11 +91,14 @@ def test_check_reports_in_the_scene_units_with_the_pump_schedule(tmp_path, capsy
     lines = out.splitlines()
     assert lines[0] == (f"{path}: ok; physics fracture, end time 1 200 s, cells 20 x 20 ft, output every 120 s, "
                         "units field (the scene's values: 15 in field units, 0 in SI; set [output] units to choose)")
-    assert lines[-4:] == [
+    table = lines.index("pump schedule")
+    assert lines[table:table + 4] == [
         "pump schedule",
         "  stage         start [min]  end [min]  rate [bbl/min]  clean [bbl]  slurry [bbl]",
         "  1      fluid            0         20              20          400           400",
         "  total                             20                          400           400"]
+    assert lines[table + 4].startswith("expected (a radial fracture at the mean rate 20 bbl/min")
+    assert "fracture cells" in lines[-1]
 
 
 # --- one rule each: a bad scene, the exact message --------------------------------------------------------------

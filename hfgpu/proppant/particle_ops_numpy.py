@@ -60,6 +60,7 @@ class GridFields:
     mean_v: np.ndarray
     damping_rate: np.ndarray
     width: np.ndarray
+    free_grains: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -131,7 +132,7 @@ def finish_moments(sums: np.ndarray, frame: GridFrame, width: np.ndarray) -> Cel
 def grid_fields(frame: GridFrame, width: np.ndarray, u: np.ndarray, v: np.ndarray, pressure: np.ndarray,
                 moments: CellMoments, params: MppicParams) -> GridFields:
     """Node fields for the gather: pressure and stress (Eq. 16) gradients differenced to active faces
-    (0 elsewhere), and the damping rate 1/tau_D per cell (O'Rourke & Snider 2010 eq. 48)."""
+    (0 elsewhere), the damping rate 1/tau_D per cell (O'Rourke & Snider 2010 eq. 48) and ``free_grains``."""
     check_fluid(width, u, v, pressure)
     cell, xmask, zmask = active_nodes(width)
     tau = closures.particle_stress(moments.volume_fraction, params)
@@ -153,19 +154,32 @@ def grid_fields(frame: GridFrame, width: np.ndarray, u: np.ndarray, v: np.ndarra
                       fluid_v=np.ascontiguousarray(v, dtype=np.float64),
                       dpdx=grad_x(pressure), dpdz=grad_z(pressure), dtaudx=grad_x(tau), dtaudz=grad_z(tau),
                       volume_fraction=moments.volume_fraction, mean_u=moments.mean_u, mean_v=moments.mean_v,
-                      damping_rate=damping * cell, width=np.ascontiguousarray(width, dtype=np.float64))
+                      damping_rate=damping * cell, width=np.ascontiguousarray(width, dtype=np.float64),
+                      free_grains=free_grains(moments.volume_fraction, params))
+
+
+def free_grains(volume_fraction: np.ndarray, params: MppicParams) -> np.ndarray:
+    """1 where a cell's grains take the fluid's pressure gradient -V_p grad p themselves (theta_p <
+    friction_volume_fraction), 0 in a contact network: there the skeleton carries that load to the walls and
+    floor (as it carries the bed's friction), and the fluid keeps the whole -grad p (``pressure_reaction``).
+    Why: with each grain of a settled bed taking -grad p, a parcel move that changes the fluid's storage sets a
+    pressure whose gradient moves the parcels back a step later, a loop whose gain does not depend on dt; the
+    dynamic pressure of the bed's bottom rows alternated in sign and grew ~3x a fluid step (docs/proppant-closures.md)."""
+    return (volume_fraction < params.friction_volume_fraction).astype(np.float64)
 
 
 def gather(parcels: Parcels, frame: GridFrame, fields: GridFields) -> ParcelFluid:
     """Grid fields at the parcels: face fields with x-/z-face weights (Eq. 40-41), cell fields with cell
-    weights, width of the own cell (0 outside the grid)."""
+    weights, width of the own cell (0 outside the grid); the pressure gradient times the own cell's
+    ``free_grains`` (1 outside the grid)."""
     kc, ic, wc = weights(parcels.x, parcels.z, frame, "cell", fields.cell_mask)
     kx, ix, wx = weights(parcels.x, parcels.z, frame, "xface", fields.xface_mask)
     kz, iz, wz = weights(parcels.x, parcels.z, frame, "zface", fields.zface_mask)
     ko, io, inside = owning_cell(parcels.x, parcels.z, frame, fields.width.shape)
+    free = np.where(inside, fields.free_grains[ko, io], 1.0)
     return ParcelFluid(
         fluid_u=interpolate(fields.fluid_u, kx, ix, wx), fluid_v=interpolate(fields.fluid_v, kz, iz, wz),
-        dpdx=interpolate(fields.dpdx, kx, ix, wx), dpdz=interpolate(fields.dpdz, kz, iz, wz),
+        dpdx=free * interpolate(fields.dpdx, kx, ix, wx), dpdz=free * interpolate(fields.dpdz, kz, iz, wz),
         dtaudx=interpolate(fields.dtaudx, kx, ix, wx), dtaudz=interpolate(fields.dtaudz, kz, iz, wz),
         volume_fraction=interpolate(fields.volume_fraction, kc, ic, wc),
         mean_u=interpolate(fields.mean_u, kc, ic, wc), mean_v=interpolate(fields.mean_v, kc, ic, wc),
@@ -372,9 +386,10 @@ def pressure_reaction(fields: GridFields) -> tuple[np.ndarray, np.ndarray]:
     pushed the fluid towards the high pressure and drove eddies at 3-6 m/s (tests/proppant/test_inlet_speeds.py).
     The gradient is the old pressure's, the one the parcels feel: taken implicitly (the fluid feeling
     theta_f grad p^(n+1)), the loop parcels -> continuity -> pressure -> parcels gained theta_p / theta_f per
-    step and oscillated in settling beds above theta_p = 0.5."""
+    step and oscillated in settling beds above theta_p = 0.5. Cells in a contact network (``free_grains`` 0)
+    add no load: their grains do not take the gradient, so the fluid there keeps -grad p."""
     is_open = fields.width > 0.0
-    load = fields.volume_fraction * fields.width
+    load = fields.free_grains * fields.volume_fraction * fields.width
     out = []
     for axis, gradient in ((1, fields.dpdx), (0, fields.dpdz)):
         w_f = face_mean(fields.width, is_open, axis)

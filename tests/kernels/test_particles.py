@@ -190,6 +190,35 @@ def test_exchange_is_equal_and_opposite():
     assert has_x.mean() > 0.95 and has_z.mean() > 0.95
 
 
+def test_grains_in_a_contact_network_leave_the_pressure_gradient_to_the_skeleton():
+    """Parcels whose own cell has theta_p >= friction_volume_fraction see no pressure gradient, the others the
+    interpolated one (Eq. 41); the fluid's pressure reaction -theta_p,f grad p takes its load only from the
+    cells whose grains take the gradient, so a face between two such cells keeps -theta_p,f grad p and a face
+    between two contact-network cells has no reaction (the fluid keeps -grad p)."""
+    frame, width, parcels, fluid = random_case(seed=3)
+    moments = ref.finish_moments(ref.moment_sums(parcels, frame, width), frame, width)
+    fraction = float(np.median(moments.volume_fraction[moments.volume_fraction > 0]))
+    params = MppicParams(friction_volume_fraction=fraction)
+    fields = ref.grid_fields(frame, width, fluid["u"], fluid["v"], fluid["pressure"], moments, params)
+    seen = ref.gather(parcels, frame, fields)
+    k, i, _ = ref.owning_cell(parcels.x, parcels.z, frame, width.shape)
+    network = moments.volume_fraction[k, i] >= fraction
+    assert 0.2 < network.mean() < 0.8
+    np.testing.assert_array_equal(seen.dpdx[network], 0.0)
+    np.testing.assert_array_equal(seen.dpdz[network], 0.0)
+    kx, ix, wx = weights(parcels.x, parcels.z, frame, "xface", fields.xface_mask)
+    close(seen.dpdx[~network], interpolate(fields.dpdx, kx, ix, wx)[~network])
+    rx, _ = ref.pressure_reaction(fields)
+    theta, w = moments.volume_fraction, width
+    left, right = theta[:, :-1], theta[:, 1:]
+    both_free = (left < fraction) & (right < fraction) & (fields.xface_mask[:, 1:-1] > 0)
+    both_network = (left >= fraction) & (right >= fraction)
+    load = 0.5 * (left * w[:, :-1] + right * w[:, 1:]) / (0.5 * (w[:, :-1] + w[:, 1:]))
+    close(rx[:, 1:-1][both_free], -(load * fields.dpdx[:, 1:-1])[both_free])
+    np.testing.assert_array_equal(rx[:, 1:-1][both_network], 0.0)
+    assert both_free.sum() > 10 and both_network.sum() > 10
+
+
 def test_engine_exchange_is_the_drag_of_its_parcels():
     """Without a pressure gradient the sub-loop's force on the faces sums to the drag on the parcels after
     the push, sum n rho_p V_p D (u_f - u_p), from the D and u_f of the Taichi engine's work rows (equal and

@@ -1,0 +1,181 @@
+"""What ``hfgpu check`` expects of a fracture scene before it runs: the fracture's size and opening from a closed
+form, the run's work (fracture cells, proppant steps, parcels), and the warnings these lead to.
+
+The fracture is Dontsov's (2016) radial solution (:func:`hfgpu.reference.radial.dontsov_radial`, toughness,
+viscosity and Carter leak-off) with the rock at the injection depth (E' = E / (1 - nu^2), K' = 4 (2/pi)^1/2 K_Ic,
+C' = 2 C_L of that layer), mu' = 12 mu and the mean pumped rate Q = pumped volume / pumping time, at the end of
+pumping and when the first proppant is pumped. Layers are ignored: a height-contained fracture of the same volume
+is longer and about as wide, so these are scales, not predictions.
+
+The work: the fracture grid's cells pi R^2 / (dx dz) at the end of pumping; the proppant fluid steps (end time -
+first proppant) / dt, dt = min(``[mppic] dt_max``, the fluid Courant step at the perforation c_max d / u with u =
+Q / (4 d w(0)), the rate leaving the perforated cell of side d through its four faces, w(0) when the first
+proppant is pumped); at most ``max_parcels`` parcels; their product with ``particle_substeps``, the parcel
+updates, is what the particle engine's speed multiplies (docs/benchmarks.md measures both engines).
+
+Warnings (:func:`warnings`):
+
+* a proppant whose largest grain x ``bridging_factor`` exceeds the expected opening at the perforation when it
+  is first pumped: it bridges there (a screen-out at the inlet) unless the fracture is wider;
+* a fracture that reaches fewer than :data:`MIN_CELLS_RADIUS` cells from the perforation by the end of pumping
+  (the rate is too low for the leak-off, or the cells too large): the grid does not resolve it;
+* a fluid efficiency below :data:`MIN_EFFICIENCY` at the end of pumping: leak-off takes nearly all the fluid.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from .units import display_unit, format_number, in_display_units
+
+#: Cells from the perforation the fracture should reach by the end of pumping.
+MIN_CELLS_RADIUS = 3
+#: Fluid efficiency (volume in the fracture / pumped) below which leak-off is said to dominate.
+MIN_EFFICIENCY = 0.05
+#: K' [Pa m^1/2] used for a rock without toughness (the closed form needs K' > 0; the viscosity-storage radius of
+#: a 0.1 m^3/s, 12 cP, E' 20 GPa fracture at 600 s is then within 0.2 % of Savitski & Detournay's 126.4 m).
+MIN_TOUGHNESS = 1e3
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """Scales of a run before it runs (SI): the radial fracture at the end of pumping (``radius`` R [m],
+    ``efficiency``, ``opening`` w(0) [m]); the opening at the perforation when each proppant is first pumped
+    (``first_openings``: name -> (time [s], w(0) [m])); ``cells`` of the fracture grid; ``proppant_steps``,
+    ``parcels`` (an upper bound, None when set per cell) and ``parcel_updates`` (None without both)."""
+
+    pumping_time: float
+    rate: float
+    radius: float
+    efficiency: float
+    opening: float
+    first_openings: dict[str, tuple[float, float]]
+    cells: float
+    proppant_steps: int | None
+    parcels: int | None
+    parcel_updates: float | None
+
+
+def pumped(schedule: Any) -> tuple[float, float]:
+    """(pumping time [s] to the end of the last stage with rate > 0, pumped volume [m^3])."""
+    end, volume, start = 0.0, 0.0, 0.0
+    for stage in schedule.stages:
+        if stage.rate > 0.0:
+            volume += stage.rate * (stage.until - start)
+            end = stage.until
+        start = stage.until
+    return end, volume
+
+
+def first_pumped(schedule: Any) -> dict[str, float]:
+    """{proppant name: the time its first stage starts [s]}."""
+    out: dict[str, float] = {}
+    start = 0.0
+    for stage in schedule.stages:
+        if stage.proppant is not None and stage.rate > 0.0 and stage.proppant not in out:
+            out[stage.proppant] = start
+        start = stage.until
+    return out
+
+
+def estimate(scene: Any) -> Estimate | None:
+    """The module docstring's scales of a scene with a fracture and a pumped schedule (None otherwise)."""
+    from .reference.radial import dontsov_radial, scaled_parameters
+
+    if scene.rock is None or scene.injection is None or scene.fluid is None or not scene.has("fracture"):
+        return None
+    t_pump, volume = pumped(scene.injection.schedule)
+    if t_pump <= 0.0 or volume <= 0.0:
+        return None
+    rock, depth = scene.rock, scene.injection.depth
+    groups = scaled_parameters(rock.youngs_modulus, rock.poisson_ratio, float(rock.toughness_at([depth])[0]),
+                               scene.fluid.viscosity, float(rock.leakoff_at([depth])[0]))
+    rate = volume / t_pump
+    toughness = max(groups.K_prime, MIN_TOUGHNESS)
+
+    def radial(t: float):
+        return dontsov_radial(groups.E_prime, toughness, groups.mu_prime, groups.C_prime, rate, t)
+
+    end = radial(t_pump)
+    radius = float(end.R[-1])
+    first: dict[str, tuple[float, float]] = {}
+    for name, t in first_pumped(scene.injection.schedule).items():
+        t_seen = max(t, 1e-3 * t_pump)  # sand from the first second: the opening a moment after it starts
+        first[name] = (t, float(radial(t_seen).w0[-1]))
+    cells = math.pi * radius**2 / (scene.mesh.dx * scene.mesh.dz)
+    steps = parcels = updates = None
+    if scene.proppant is not None and scene.coupling is not None and first:
+        numerics = scene.proppant.numerics
+        side = min(scene.coupling.cell_size or (scene.mesh.dx, scene.mesh.dz))
+        t0, w0 = min(first.values())
+        courant = numerics.c_max * 4.0 * w0 * side**2 / rate
+        steps = math.ceil((scene.run.end_time - t0) / min(numerics.dt_max, courant))
+        parcels = numerics.max_parcels
+        if parcels is not None:
+            updates = float(steps) * numerics.particle_substeps * parcels
+    return Estimate(pumping_time=t_pump, rate=rate, radius=radius, efficiency=float(end.efficiency[-1]),
+                    opening=float(end.w0[-1]), first_openings=first, cells=cells, proppant_steps=steps,
+                    parcels=parcels, parcel_updates=updates)
+
+
+def _shown(value: float, kind: str, system: str) -> str:
+    return f"{format_number(in_display_units(value, kind, system), 3)} {display_unit(kind, system)}"
+
+
+def report(scene: Any, system: str) -> str:
+    """The lines ``hfgpu check`` prints under "expected" ("" when :func:`estimate` has nothing to say)."""
+    e = estimate(scene)
+    if e is None:
+        return ""
+    minutes = format_number(e.pumping_time / 60.0, 3)
+    lines = [f"expected (a radial fracture at the mean rate {_shown(e.rate, 'rate', system)} in the rock at the "
+             "injection depth, Dontsov 2016; layers ignored; docs/scene.md):",
+             f"  {'at the end of pumping':32} {minutes} min: radius {_shown(e.radius, 'length', system)}, "
+             f"opening at the perforation {_shown(e.opening, 'width', system)}, fluid efficiency "
+             f"{format_number(100.0 * e.efficiency, 2)} %",
+             f"  {'fracture cells':32} ~{format_number(e.cells, 2)} (pi R^2 / cell area)"]
+    for name, (t, w0) in e.first_openings.items():
+        lines.append(f"  {'opening when ' + name + ' starts':32} {_shown(w0, 'width', system)} "
+                     f"(t = {format_number(t / 60.0, 3)} min)")
+    if e.proppant_steps is not None:
+        work = f"~{format_number(e.proppant_steps, 2)} (dt_max or the fluid Courant step at the perforation)"
+        if e.parcel_updates is not None:
+            work += (f"; at most {format_number(e.parcels, 3)} parcels: ~{e.parcel_updates:.2g} parcel updates "
+                     "(docs/benchmarks.md: the engines' speed)")
+        lines.append(f"  {'proppant steps':32} {work}")
+    return "\n".join(lines)
+
+
+def warnings(scene: Any, system: str) -> list[str]:
+    """The module docstring's warnings, in the scene's units, naming the key each concerns."""
+    e = estimate(scene)
+    if e is None:
+        return []
+    found = []
+    cell = max(scene.mesh.dx, scene.mesh.dz)
+    if e.radius < MIN_CELLS_RADIUS * cell:
+        found.append(f"injection.schedule: the fracture is expected to reach about {_shown(e.radius, 'length', system)}"
+                     f" from the perforation by the end of pumping (a radial estimate, Dontsov 2016), fewer than "
+                     f"{MIN_CELLS_RADIUS} cells of {_shown(cell, 'length', system)}: the grid does not resolve it; "
+                     "use finer cells ([mesh] cell_size) or a higher rate")
+    if e.efficiency < MIN_EFFICIENCY:
+        found.append(f"injection.schedule: only about {format_number(100.0 * e.efficiency, 2)} % of the pumped fluid "
+                     f"is expected in the fracture at the end of pumping (rock.leakoff_coefficient at the injection "
+                     f"depth, mean rate {_shown(e.rate, 'rate', system)}): leak-off takes nearly all of it and the "
+                     "fracture stays small; a higher rate or a lower leak-off opens it")
+    if scene.proppant is None:
+        return found
+    factor = scene.proppant.params.bridging_factor
+    for i, spec in enumerate(scene.proppant.classes):
+        if spec.name not in e.first_openings:
+            continue
+        t, w0 = e.first_openings[spec.name]
+        if factor * spec.size.d_max > w0:
+            found.append(f"proppant[{i}] ({spec.name}): its largest grain {_shown(spec.size.d_max, 'width', system)} "
+                         f"x bridging_factor {factor:g} exceeds the expected opening at the perforation when it is "
+                         f"first pumped, {_shown(w0, 'width', system)} at {format_number(t / 60.0, 3)} min (a radial "
+                         "estimate, Dontsov 2016): it bridges at the inlet unless the fracture is wider; a longer "
+                         "pad, a higher rate or viscosity, or a finer grain")
+    return found

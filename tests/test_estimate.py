@@ -1,0 +1,98 @@
+"""``hfgpu check``'s expectations (hfgpu.estimate): the radial closed form's scales of a scene and the warnings
+they lead to, on the corpus's treatments (written as engineers write them: none of these warnings) and on
+treatments an engineer gets wrong (a grain too large for the opening, a rate too low for the leak-off)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from hfgpu import edit_scene, load_scene
+from hfgpu.estimate import MIN_EFFICIENCY, estimate, first_pumped, pumped, warnings
+from hfgpu.reference.radial import dontsov_radial, scaled_parameters
+from hfgpu.scene_checks import validate
+
+SCENES = Path(__file__).resolve().parents[1] / "bench" / "scenes"
+STAGE = SCENES / "corpus_permian_slickwater_stage.toml"
+BBL_MIN = 0.158987294928 / 60.0
+
+
+def stage(**changes):
+    return validate(edit_scene(load_scene(STAGE.read_text()), changes))
+
+
+def test_pumped_time_volume_and_first_proppant_of_the_stage():
+    """Issue 30's stage: 50 min at 80 bbl/min (4 000 bbl); 100 mesh from 15 min, 40/70 from 30 min."""
+    scene = stage()
+    t, volume = pumped(scene.injection.schedule)
+    assert t == pytest.approx(3000.0)
+    assert volume == pytest.approx(4000 * 0.158987294928, rel=1e-9)
+    assert first_pumped(scene.injection.schedule) == pytest.approx({"100 mesh": 900.0, "40/70": 1800.0})
+
+
+def test_the_estimate_is_the_radial_solution_of_the_mean_rate_in_the_perforated_layer():
+    scene = stage()
+    e = estimate(scene)
+    rock, depth = scene.rock, scene.injection.depth
+    g = scaled_parameters(rock.youngs_modulus, rock.poisson_ratio, float(rock.toughness_at([depth])[0]),
+                          scene.fluid.viscosity, float(rock.leakoff_at([depth])[0]))
+    ref = dontsov_radial(g.E_prime, g.K_prime, g.mu_prime, g.C_prime, 80 * BBL_MIN, 3000.0)
+    assert e.rate == pytest.approx(80 * BBL_MIN, rel=1e-9)
+    assert e.radius == pytest.approx(float(ref.R[-1]), rel=1e-12)
+    assert e.cells == pytest.approx(3.14159265 * e.radius**2 / (scene.mesh.dx * scene.mesh.dz), rel=1e-6)
+    assert 0.0 < e.efficiency < 1.0 and e.opening > 0.0
+
+
+@pytest.mark.parametrize("path", sorted(SCENES.glob("corpus_*.toml")), ids=lambda p: p.stem)
+def test_the_corpus_treatments_get_none_of_these_warnings(path):
+    scene = validate(path)
+    assert warnings(scene, scene.output.units) == []
+
+
+def test_a_grain_larger_than_the_opening_is_warned_with_its_key():
+    """20/40 (grains to 0.84 mm) in slickwater at 10 bbl/min with no pad: the opening at the perforation is
+    ~1 mm, less than 2 grains."""
+    scene = stage(**{"proppant[1].size": "20/40", "injection.schedule[0].rate": "10 bbl/min",
+                     "injection.schedule[1].rate": "10 bbl/min", "injection.schedule[2].rate": "10 bbl/min"})
+    found = [w for w in scene.warnings if "bridges at the inlet" in w]
+    assert len(found) == 1 and found[0].startswith("proppant[1] (40/70)") and " in " in found[0]
+
+
+def test_a_rate_too_low_for_the_leakoff_is_warned():
+    """5 bbl/min into 10 times the stage's leak-off coefficient: ~2.5 % of the fluid stays in the fracture."""
+    rates = {f"injection.schedule[{i}].rate": "5 bbl/min" for i in range(3)}
+    scene = stage(**rates, **{"rock.leakoff_coefficient": "3e-3 ft/min**0.5"})
+    assert estimate(scene).efficiency < MIN_EFFICIENCY
+    assert any("of the pumped fluid" in w and "leak-off takes nearly all" in w for w in scene.warnings)
+
+
+def test_a_fracture_of_a_few_cells_is_warned():
+    """5 bbl/min on 80 ft cells: a radius of ~230 ft, under 3 cells."""
+    rates = {f"injection.schedule[{i}].rate": "5 bbl/min" for i in range(3)}
+    scene = stage(**rates, **{"mesh.cell_size": "80 ft"})
+    found = [w for w in scene.warnings if "does not resolve it" in w]
+    assert len(found) == 1 and "fewer than 3 cells of 80 ft" in found[0]
+
+
+def test_check_prints_the_expected_scales_and_work():
+    out = subprocess.run([sys.executable, "-m", "hfgpu.cli", "check", str(STAGE)], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    text = out.stdout
+    assert "expected (a radial fracture at the mean rate 80 bbl/min" in text
+    assert "fracture cells" in text and "proppant steps" in text and "parcel updates" in text
+    assert "opening when 40/70 starts" in text and " in (t = 30 min)" in text
+
+
+def test_a_rock_without_toughness_gets_the_viscosity_storage_radius():
+    """K_Ic = 0, no leak-off: the M vertex of Savitski & Detournay (2002), R = 0.6955 (E' Q^3 t^4 / mu')^(1/9)."""
+    from hfgpu.reference.radial import m_vertex
+
+    changes = {"rock.toughness": "0 psi*in**0.5", "rock.leakoff_coefficient": "0 ft/min**0.5"}
+    scene = stage(**changes)
+    e = estimate(scene)
+    g = scaled_parameters(scene.rock.youngs_modulus, scene.rock.poisson_ratio, 0.0, scene.fluid.viscosity, 0.0)
+    assert e.radius == pytest.approx(float(m_vertex(g.E_prime, g.mu_prime, e.rate, 3000.0).R), rel=0.01)
+    assert e.efficiency == pytest.approx(1.0)
