@@ -82,13 +82,12 @@ def first_pumped(schedule: Any) -> dict[str, float]:
 
 def estimate(scene: Any) -> Estimate | None:
     """The module docstring's scales of a scene with a fracture and a pumped schedule (None otherwise)."""
-    from .reference.radial import dontsov_radial, scaled_parameters
-
     if scene.rock is None or scene.injection is None or scene.fluid is None or not scene.has("fracture"):
         return None
     t_pump, volume = pumped(scene.injection.schedule)
     if t_pump <= 0.0 or volume <= 0.0:
         return None
+    from .reference.radial import dontsov_radial, scaled_parameters  # a fracture scene's: a proppant run needs none
     rock, depth = scene.rock, scene.injection.depth
     groups = scaled_parameters(rock.youngs_modulus, rock.poisson_ratio, float(rock.toughness_at([depth])[0]),
                                scene.fluid.viscosity, float(rock.leakoff_at([depth])[0]))

@@ -230,7 +230,7 @@ def _reopen(scene: Scene, out: Path):
     if results.status == "complete":
         print(f"{out}: the run is already complete; nothing to resume", flush=True)
         return results.summary
-    writer, time, state = ResultsWriter.reopen(out)
+    writer, time, state = ResultsWriter.reopen(out, scene)   # the scene's [wellbore] gives the rows their STP
     kept = open_results(out)
     if len(scene.run.physics) > 1:
         state["fracture_snapshots"] = kept.fracture_snapshots[:]

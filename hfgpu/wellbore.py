@@ -22,12 +22,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from functools import partial
+from typing import Any, Callable
 
 import numpy as np
 
 from .errors import MISSING, SceneError
-from .scene_reader import Table
+from .scene_reader import Table, scene_system
+from .units import display_text
 
 GRAVITY = 9.81
 #: Reynolds number above which the Blasius friction factor is used.
@@ -45,7 +47,8 @@ class Wellbore:
 
 
 def parse_wellbore(t: Table, perforation_depth: float) -> Wellbore:
-    """``[wellbore]`` of a scene whose perforations are at ``perforation_depth`` [m] (true vertical)."""
+    """``[wellbore]`` of a scene whose perforations are at ``perforation_depth`` [m] (true vertical); an error
+    quotes that depth in the scene's units (:func:`hfgpu.scene_reader.scene_system`)."""
     length = t.quantity("measured_depth", "length", minimum=0.0, exclusive_minimum=True)
     gradient = t.quantity("friction_gradient", "stress_gradient", None, minimum=0.0)
     if gradient is None and not t.has("inner_diameter"):
@@ -55,7 +58,7 @@ def parse_wellbore(t: Table, perforation_depth: float) -> Wellbore:
     if length < perforation_depth:
         raise SceneError(t.key_path("measured_depth"), t.raw("measured_depth"),
                          f"allowed: at least the perforations' true vertical depth ([injection] depth = "
-                         f"{perforation_depth:g} m)")
+                         f"{display_text(perforation_depth, 'depth', scene_system(), digits=6)})")
     t.finish()
     return Wellbore(measured_depth=length, inner_diameter=diameter, friction_gradient=gradient)
 
@@ -98,3 +101,9 @@ def surface_pressure(scene: Any, time: np.ndarray, bhtp: np.ndarray) -> np.ndarr
     hydrostatic = density * GRAVITY * scene.injection.depth
     return np.asarray(bhtp, dtype=np.float64) - hydrostatic + pipe_friction(scene.wellbore, rate, density,
                                                                             scene.fluid.viscosity)
+
+
+def surface_pressure_of(scene: Any) -> Callable[[np.ndarray, np.ndarray], np.ndarray] | None:
+    """The STP function ``(time [s], BHTP [Pa]) -> STP [Pa]`` of :func:`surface_pressure` for ``scene``, or None
+    when it has no ``[wellbore]`` (the results writer stores STP per fracture balance row with it)."""
+    return partial(surface_pressure, scene) if getattr(scene, "wellbore", None) is not None else None

@@ -7,6 +7,7 @@ from pathlib import Path
 from ..closure.conductivity import closure_of
 from ..errors import HfgpuError
 from .export_csv import write_csv
+from .export_map import export_map
 from .export_stimplan import write_stimplan
 from .export_vtk import write_vtk
 from .results import Results, open_results
@@ -24,8 +25,9 @@ def output_units(results: Results) -> str:
 
 def export(path: str | Path, fmt: str, out: str | Path, units: str | None = None) -> list[Path]:
     """Export the results file ``path`` as ``fmt`` to ``out`` in ``units`` ("SI" or "field"; default the
-    scene's ``[output] units``); return the files written. The closure map is the file's ``/closure`` group,
-    or is computed from its proppant snapshots (:func:`hfgpu.closure.conductivity.closure_of`)."""
+    scene's ``[output] units``); return the files written. StimPlan and CSV write the map of
+    :func:`hfgpu.io.export_map.export_map` (the created fracture and, with proppant, the closure map: the file's
+    ``/closure`` group, or computed from its proppant snapshots, :func:`hfgpu.closure.conductivity.closure_of`)."""
     if fmt not in FORMATS:
         raise HfgpuError(f"export format {fmt!r}: allowed {', '.join(FORMATS)}")
     results = open_results(path)
@@ -36,9 +38,8 @@ def export(path: str | Path, fmt: str, out: str | Path, units: str | None = None
     if fmt == "vtk":
         has_closure = len(results.proppant_snapshots) and (results.closure is not None or _scene_has_closure(results))
         return write_vtk(results, closure_of(results) if has_closure else None, out)
-    closure = closure_of(results)
     writer = write_stimplan if fmt == "stimplan-xml" else write_csv
-    return writer(results, closure, out, system)
+    return writer(results, export_map(results), out, system)
 
 
 def _scene_has_closure(results: Results) -> bool:

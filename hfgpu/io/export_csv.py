@@ -1,12 +1,13 @@
-"""``hfgpu export --format csv``: the closure map and the pressure history as plain CSV tables.
+"""``hfgpu export --format csv``: the export map and the pressure history as plain CSV tables.
 
-``FILE`` (the map): one row per cell of the closure grid, columns ``x``, ``depth`` (cell centre),
-``propped`` (0/1), ``propped_width``, ``conductivity``, ``permeability``, ``closure_stress``,
-``sauter_diameter``; ``<stem>_pressure.csv`` beside it: one row per snapshot (the fracture's, or the proppant
-grid's for a proppant-only run), columns ``time``, ``pressure_injection`` (the cell nearest the injection
-point, NaN when the scene names none), ``pressure_mean`` and ``pressure_max`` (over the open cells). Each
-header names the unit, e.g. ``conductivity [md ft]``, in SI or field units; a run that did not complete adds a
-first line ``# hfgpu: the run is not complete (status "...")``.
+``FILE`` (the map, :mod:`hfgpu.io.export_map`): one row per cell of its grid, columns ``x``, ``depth`` (cell
+centre), then with proppant ``propped`` (0/1), ``propped_width``, ``conductivity``, ``permeability``,
+``closure_stress``, ``sauter_diameter`` (0 where the proppant grid does not reach), then with a fracture ``width``
+(created width) and ``pressure`` (fluid pressure; both 0 in closed cells); ``<stem>_pressure.csv`` beside it: one
+row per snapshot (the fracture's, or the proppant grid's for a proppant-only run), columns ``time``,
+``pressure_injection`` (the cell nearest the injection point, NaN when the scene names none), ``pressure_mean``
+and ``pressure_max`` (over the open cells). Each header names the unit, e.g. ``conductivity [md ft]``, in SI or
+field units; a run that did not complete adds a first line ``# hfgpu: the run is not complete (status "...")``.
 """
 
 from __future__ import annotations
@@ -19,26 +20,35 @@ import numpy as np
 from ..closure.display import in_units, unit_label
 from .export_common import injection_point, round_off, status_note
 
-MAP_COLUMNS = ("x", "depth", "propped", "propped_width", "conductivity", "permeability", "closure_stress",
-               "sauter_diameter")
+PROPPANT_COLUMNS = ("propped", "propped_width", "conductivity", "permeability", "closure_stress", "sauter_diameter")
+FRACTURE_COLUMNS = ("width", "pressure")
+#: The closure quantity whose unit each fracture column takes (hfgpu.closure.display: widths m or in, Pa or psi).
+_QUANTITY = {"width": "propped_width"}
 
 
-def _header(names: tuple[str, ...], system: str) -> str:
-    return ",".join(name if name == "propped" else f"{name} [{unit_label(name, system)}]" for name in names)
+def _header(names: list[str], system: str) -> str:
+    return ",".join(name if name == "propped" else f"{name} [{unit_label(_QUANTITY.get(name, name), system)}]"
+                    for name in names)
 
 
-def write_csv(results: Any, closure: Any, out: Path, system: str) -> list[Path]:
-    """Write the map to ``out`` and the pressure history to ``<stem>_pressure.csv``; return both paths."""
-    fields = closure.fields
-    nz, nx = fields["propped_width"].shape
-    x, z = closure.frame.centres(nz, nx)
+def map_columns(grid: Any) -> list[str]:
+    """The map's columns for ``grid`` (an :class:`hfgpu.io.export_map.ExportMap`), in order."""
+    return ["x", "depth", *(n for n in PROPPANT_COLUMNS + FRACTURE_COLUMNS if n in grid.fields)]
+
+
+def write_csv(results: Any, grid: Any, out: Path, system: str) -> list[Path]:
+    """Write the map of ``grid`` (an :class:`hfgpu.io.export_map.ExportMap`) to ``out`` and the pressure
+    history to ``<stem>_pressure.csv``; return both paths."""
+    nz, nx = grid.shape
+    x, z = grid.frame.centres(nz, nx)
     grid_x, grid_z = np.meshgrid(x, z)
-    columns = {"x": round_off(grid_x, float(np.max(np.abs(grid_z), initial=1.0))), "depth": grid_z, **fields}
-    table = np.column_stack([np.ravel(columns[n]) if n == "propped" else np.ravel(in_units(n, columns[n], system))
-                             for n in MAP_COLUMNS])
+    columns = {"x": round_off(grid_x, float(np.max(np.abs(grid_z), initial=1.0))), "depth": grid_z, **grid.fields}
+    names = map_columns(grid)
+    table = np.column_stack([np.ravel(columns[n]) if n == "propped"
+                             else np.ravel(in_units(_QUANTITY.get(n, n), columns[n], system)) for n in names])
     note = status_note(results)
     first = f"# {note}\n" if note else ""   # a comment line (pandas: comment="#") only for a run that did not complete
-    np.savetxt(out, table, delimiter=",", header=first + _header(MAP_COLUMNS, system), comments="", fmt="%.10g")
+    np.savetxt(out, table, delimiter=",", header=first + _header(names, system), comments="", fmt="%.10g")
     pressure = out.with_name(out.stem + "_pressure.csv")
     history = pressure_history(results)
     table = np.column_stack([history[0]] + [in_units("pressure", column, system) for column in history[1:]])

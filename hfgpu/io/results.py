@@ -5,7 +5,7 @@ Layout (docs/results-format.md is the full contract; extend, never rename)::
     /                       attrs format="hfgpu-results", format_version, hfgpu_version, status
     /scene                  the scene's TOML text (UTF-8 string)
     /fracture/snapshots/000000 ...   attrs time, dx, dz, x0, z0; width, pressure, leakoff_rate, opening_time, extras
-    /fracture/balance       time, injected, stored, leaked (1-D, appended)
+    /fracture/balance       time, injected, stored, leaked, ..., surface_pressure with [wellbore] (1-D, appended)
     /proppant/snapshots/000000 ...   attrs time, dx, dz, x0, z0, n_parcels; per-parcel and grid datasets
     /proppant/balance       time, injected, in_domain, outflow, screened_out (1-D, appended)
     /summary                attrs status, message, and the simulator's scalar summary values
@@ -66,7 +66,7 @@ NEW_CHECKPOINT = "_checkpoint_new"
 #: Units of every dataset name the writer knows (SI; "1" is dimensionless, "" is text or a label).
 UNITS = {
     "time": "s", "injected": "m^3", "stored": "m^3", "leaked": "m^3", "in_domain": "m^3", "outflow": "m^3",
-    "screened_out": "m^3", "injection_pressure": "Pa", "efficiency": "1",
+    "screened_out": "m^3", "injection_pressure": "Pa", "surface_pressure": "Pa", "efficiency": "1",
     "width": "m", "pressure": "Pa", "leakoff_rate": "m/s", "opening_time": "s",
     "net_pressure": "Pa", "min_stress": "Pa", "toughness": "Pa m^0.5", "leakoff_coefficient": "m/s^0.5",
     "x": "m", "z": "m", "u": "m/s", "v": "m/s", "radius": "m", "density": "kg/m^3", "particles": "1",
@@ -86,6 +86,8 @@ UNKNOWN_UNITS = "unspecified"
 FRACTURE_FIELDS = ("width", "pressure", "leakoff_rate", "opening_time")
 FRACTURE_BALANCE = ("time", "injected", "stored", "leaked", "injection_pressure", "net_pressure", "efficiency",
                     "area", "length", "height", "inlet_width")
+#: The fracture balance column a scene with ``[wellbore]`` adds after FRACTURE_BALANCE: the STP of each row.
+SURFACE_PRESSURE = "surface_pressure"
 PROPPANT_BALANCE = ("time", "injected", "in_domain", "outflow", "screened_out")
 _BALANCE_FLUSH_ROWS = 4096
 _COMPRESS_ABOVE = 4096  # elements; smaller arrays are stored plainly
@@ -285,7 +287,7 @@ class ResultsWriter:
         from .. import __version__
 
         acquire_lock(Path(path))
-        self._start(Path(path), {"fracture": 0, "proppant": 0}, 0.0)
+        self._start(Path(path), {"fracture": 0, "proppant": 0}, 0.0, scene)
         try:
             with _edit(self.path, create=True) as f:
                 f.attrs.update(format=FORMAT, format_version=FORMAT_VERSION, hfgpu_version=__version__,
@@ -295,8 +297,11 @@ class ResultsWriter:
             release_lock(self.path)
             raise HfgpuError(f"cannot create the results file '{self.path}': {exc}") from None
 
-    def _start(self, path: Path, counts: dict[str, int], last_time: float) -> None:
+    def _start(self, path: Path, counts: dict[str, int], last_time: float, scene: Any) -> None:
+        from ..wellbore import surface_pressure_of
+
         self.path = path
+        self._surface = surface_pressure_of(scene)   # None without [wellbore]
         self._counts = counts
         self._pending: dict[str, list[tuple[float, ...]]] = {"fracture": [], "proppant": []}
         self._last_time = last_time
@@ -304,9 +309,9 @@ class ResultsWriter:
         self._file = _TwinFile(path)
 
     @classmethod
-    def reopen(cls, path: str | Path) -> tuple["ResultsWriter", float, dict]:
-        """(writer, time, state): continue the results file ``path`` from its checkpoint. Snapshots and
-        balance rows written after the checkpoint are dropped, ``/summary`` removed and the status set back
+    def reopen(cls, path: str | Path, scene: Any = None) -> tuple["ResultsWriter", float, dict]:
+        """(writer, time, state): continue the results file ``path`` of ``scene`` from its checkpoint. Snapshots
+        and balance rows written after the checkpoint are dropped, ``/summary`` removed and the status set back
         to "running"; ``state`` is the tree the simulator saved at simulated time ``time`` [s]. Raises
         :class:`HfgpuError` for a file that is not a results file or holds no checkpoint."""
         path = Path(path)
@@ -317,7 +322,7 @@ class ResultsWriter:
             release_lock(path)
             raise
         writer = cls.__new__(cls)
-        writer._start(path, counts, time)
+        writer._start(path, counts, time, scene)
         return writer, time, state
 
     @staticmethod
@@ -502,16 +507,22 @@ class ResultsWriter:
             self._file.apply(lambda f: _append_rows(f, rows))
 
     def _take_rows(self) -> dict[str, np.ndarray]:
-        """The buffered balance rows of each physics as (rows, columns) arrays, the buffers emptied."""
+        """The buffered balance rows of each physics as (rows, columns) arrays, the buffers emptied; with
+        ``[wellbore]`` the fracture rows get their STP (:func:`hfgpu.wellbore.surface_pressure`) as a last column."""
         rows = {physics: np.array(pending, dtype=np.float64) for physics, pending in self._pending.items() if pending}
         for pending in self._pending.values():
             pending.clear()
+        fracture = rows.get("fracture")
+        if fracture is not None and self._surface is not None:
+            bhtp = fracture[:, FRACTURE_BALANCE.index("injection_pressure")]
+            rows["fracture"] = np.column_stack([fracture, self._surface(fracture[:, 0], bhtp)])
         return rows
 
 
 def _append_rows(f: h5py.File, rows: dict[str, np.ndarray]) -> None:
-    """Append balance rows ({physics: (rows, columns) array}) to ``/<physics>/balance``."""
-    for physics, names in (("fracture", FRACTURE_BALANCE), ("proppant", PROPPANT_BALANCE)):
+    """Append balance rows ({physics: (rows, columns) array}) to ``/<physics>/balance``, one dataset per column
+    (fracture rows without the STP column leave ``surface_pressure`` out: zip stops at the last column)."""
+    for physics, names in (("fracture", FRACTURE_BALANCE + (SURFACE_PRESSURE,)), ("proppant", PROPPANT_BALANCE)):
         if physics not in rows:
             continue
         group = f.require_group(f"{physics}/balance")

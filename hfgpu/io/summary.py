@@ -20,10 +20,10 @@ screen-out that did not happen, reads "never"):
   resumed from, results file.
 
 Proppant amounts are masses where every class has the same grain density, else solid volumes. Numbers are
-written by :func:`hfgpu.units.format_number` (4 significant figures, thousands grouped by a thin space).
+written by :func:`hfgpu.units.format_number` (4 significant figures, thousands grouped by a space: "13 020 lb").
 
 Pressures (:func:`treatment_pressures`): BHTP is the fluid pressure in the perforated cell (``injection_pressure``
-of ``/fracture/balance``, absolute like the layer stresses); ISIP is the BHTP of the first record after the pumps
+of ``/fracture/balance``, absolute like the layer stresses), STP its ``surface_pressure`` (:func:`surface_history`); ISIP is the BHTP of the first record after the pumps
 stop (the first step of the shut-in: no extrapolation, the record itself).
 """
 
@@ -109,8 +109,16 @@ def treatment_pressures(balance: dict[str, np.ndarray], stop: float | None,
 
 
 def surface_history(balance: dict[str, np.ndarray] | None, scene: Any) -> np.ndarray | None:
-    """The STP [Pa] of each record of ``/fracture/balance`` for a scene with ``[wellbore]`` (else None)."""
-    if not balance or getattr(scene, "wellbore", None) is None:
+    """The STP [Pa] of each record of ``/fracture/balance``: its ``surface_pressure`` column, stored for a scene
+    with ``[wellbore]``; for a file written before hfgpu stored it (no column, or one shorter than ``time``),
+    computed from ``scene``'s ``[wellbore]`` as the writer would (:func:`hfgpu.wellbore.surface_pressure`);
+    None without either."""
+    if not balance:
+        return None
+    stored = balance.get("surface_pressure")
+    if stored is not None and stored.shape == balance["time"].shape:
+        return stored
+    if getattr(scene, "wellbore", None) is None:
         return None
     from ..wellbore import surface_pressure
 
