@@ -212,9 +212,9 @@ def main() -> None:
         args.scenes = list(scenes)
     runs = [(name, preset) for name in args.scenes for preset in args.presets]
     done: dict[tuple[str, str], Outcome] = {}
-    with ThreadPoolExecutor(max_workers=args.jobs) as pool:
+    with ThreadPoolExecutor(max_workers=args.jobs) as pool:  # started preset by preset, in --presets' order
         futures = {pool.submit(run_one, name, scenes[name], preset, args.out, args.timeout, args.threads):
-                   (name, preset) for name, preset in runs}
+                   (name, preset) for preset in args.presets for name in args.scenes}
         for future in as_completed(futures):
             row = future.result()
             done[futures[future]] = row
