@@ -26,10 +26,12 @@ from typing import Any
 
 from ..errors import HfgpuError
 from ..interrupts import stop_signals_interrupt
+from ..scene import unit_system
 from .members import Member, members
 from .metrics import member_metrics, propped_map
 from .summary import CsvWriter, columns, common_fraction, row, write_csv, write_ensemble
 from .sweep_file import load_sweep
+from .table_units import ColumnUnits, column_kinds
 
 #: Further attempts of a member whose worker was lost (or that raised OSError): at most 1 + 2 runs.
 MEMBER_RETRIES = 2
@@ -88,12 +90,14 @@ def sweep(sweep_file: str | Path, out: str | Path, *, workers: int | None = None
     folder.mkdir(parents=True, exist_ok=True)
     names = list(spec.metrics)
     header = columns([v.key for v in spec.vary], names)
+    kinds = column_kinds({v.key: v.kind for v in spec.vary}, names)
+    units = ColumnUnits(kinds, unit_system(spec.scene_data), stored=True)
     rows = {}
     for m in todo:
         kept = _complete_row(m, folder / f"{m.id}.h5", names) if resume else None
         if kept is not None:
             rows[m.id] = kept
-    writer = CsvWriter(out / "summary.csv", header)
+    writer = CsvWriter(out / "summary.csv", header, units)
     for values in rows.values():
         writer.write(values)
     pending = [m for m in todo if m.id not in rows]
@@ -107,28 +111,20 @@ def sweep(sweep_file: str | Path, out: str | Path, *, workers: int | None = None
     finally:
         writer.close()
     ordered = [rows[m.id] for m in todo]
-    write_csv(out / "summary.csv", header, ordered)
-    write_ensemble(out / "ensemble.h5", spec.source, header, ordered, names, _propped(folder, ordered))
+    write_csv(out / "summary.csv", header, ordered, units)
+    write_ensemble(out / "ensemble.h5", spec.source, header, ordered, names, _propped(folder, ordered), units)
     return ordered
-
-
-#: The display kind (hfgpu.units.DISPLAY_UNITS) of each SI metric unit (hfgpu.ensemble.metrics.UNITS).
-METRIC_KINDS = {"m^2": "area", "m": "length", "Pa": "pressure"}
 
 
 def percentile_lines(rows: list[dict[str, Any]], names: list[str], system: str) -> list[str]:
     """One line per metric, "name [unit]  P10 ...  P50 ...  P90 ..." over the complete members
     (:func:`hfgpu.ensemble.summary.percentiles`), in ``system``'s display units (the base scene's
     ``[output] units``); ratios and flags as they are."""
-    from ..io.display_units import FigureUnits
-    from .metrics import UNITS
     from .summary import percentiles
 
-    units, lines = FigureUnits(system), []
+    units, lines = ColumnUnits(column_kinds({}, names), system), []
     for name in names:
-        kind = METRIC_KINDS.get(UNITS.get(name, "-"))
-        values = percentiles(rows, name)
-        shown, label = (units(kind, values), units.label(kind)) if kind else (values, "-")
+        shown, label = units(name, percentiles(rows, name)), units.label(name)
         lines.append((f"  {name + ' [' + label + ']':<32}" + "  ".join(f"P{level} {_number(v):<10}" for level, v
                                                                        in zip((10, 50, 90), shown))).rstrip())
     return lines
@@ -180,10 +176,25 @@ def _run_members(pending: list[Member], folder: Path, names: list[str], total: i
             bar.update()
             yield row(m.id, status, m.inputs, metrics, names, wall)
         bar.close()
+        if cluster is not None:   # every member done: nothing runs in the workers
+            client.run(release_kernels, on_error="ignore")
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def release_kernels() -> None:
+    """Run in each local worker once its members are done: finalise Taichi (``ti.reset``) where a member used it,
+    which writes the kernels the worker compiled into Taichi's offline cache (kernels/runtime.py) for later
+    workers and sweeps. Left to the worker's exit, that finalisation ran inside the 4 s Dask's nanny gives a
+    closing worker and overran them (measured: close 4.2 s, "Worker process still alive after 4.0 seconds,
+    killing"; 0.5 s with this call first), the cache written or not depending on how far it had got."""
+    import sys
+
+    taichi = sys.modules.get("taichi")
+    if taichi is not None:
+        taichi.reset()
 
 
 def _client(workers: int | None, scheduler: str | None):

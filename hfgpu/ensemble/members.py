@@ -1,9 +1,9 @@
 """The member scenes of a sweep: the base scene with each member's inputs put in, as TOML text, all validated.
 
 A member's scene text is the base scene's TOML written back (comments dropped, values as parsed) with the
-varied keys set to the member's values in SI: with the key's SI unit when the sweep gave units ("6.5e7 Pa"),
-else as plain numbers (SI in a scene); under a comment naming the member and its inputs. It is what the
-member's results file stores under ``/scene``.
+varied keys set to the member's values in SI (a [[vary]] with ``keys`` puts its one value into each of them):
+with the key's SI unit when the sweep gave units ("6.5e7 Pa"), else as plain numbers (SI in a scene); under a
+comment naming the member and its inputs. It is what the member's results file stores under ``/scene``.
 """
 
 from __future__ import annotations
@@ -22,7 +22,8 @@ class MemberError(HfgpuError, ValueError):
 
 @dataclass(frozen=True)
 class Member:
-    """One member: ``id`` (zero-padded index, the name of its results file), inputs {key: SI value}, scene text."""
+    """One member: ``id`` (zero-padded index, the name of its results file), inputs {column: SI value} (a [[vary]]'s
+    column: its key, or its name), scene text."""
 
     id: str
     inputs: dict[str, float | int | str]
@@ -47,7 +48,8 @@ def members(sweep: Sweep) -> list[Member]:
         data = sweep.scene_data
         for vary in sweep.vary:
             value = inputs[vary.key]
-            data = with_value(data, vary.steps, f"{value!r} {vary.unit}" if vary.unit else value)
+            for _, steps in vary.targets:
+                data = with_value(data, steps, f"{value!r} {vary.unit}" if vary.unit else value)
         said = ", ".join(f"{k} = {v!r}" for k, v in inputs.items())
         text = f"# hfgpu sweep member {mid}: {said}\n"
         text += toml_text(data)

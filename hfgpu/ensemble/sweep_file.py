@@ -4,15 +4,19 @@ A sweep file is TOML: ``scene`` (the base scene, relative to the sweep file), ``
 ``design`` ("latin-hypercube", "grid" or "random"), ``seed``, one ``[[vary]]`` table per varied scene key and an
 optional ``[metrics] names``. These key names are a contract for outside tools: extend them, never rename them.
 
-Each ``[[vary]]`` has ``key`` (a scene key path, ``rock.leakoff_coefficient``, ``rock.layers[0].min_stress``) and
+Each ``[[vary]]`` has ``key`` (a scene key path, ``rock.leakoff_coefficient``, ``rock.layers[0].min_stress``), or
+``keys`` (several key paths that take the same kind of value, each set to the member's one value) with an optional
+``name`` (the summary's column; default the keys joined by "+"), and
 either ``values = [...]`` or ``distribution`` with its parameters: ``uniform`` and ``log-uniform`` (``low``,
 ``high``), ``normal`` (``mean``, ``std``), ``triangular`` (``low``, ``mode``, ``high``). Each value is a plain
 number (SI) or a string with units, as in a scene; it is checked against the key's kind by putting it into the
-base scene and parsing that, so a wrong unit gets the scene's own message, under the sweep's key path
-(``vary[0].low``). Numbers are then held in SI (pint's base units, which are SI for every scene kind) and
+base scene (into each of ``keys``) and parsing that, so a wrong unit gets the scene's own message, under the sweep's
+key path (``vary[0].low``). Numbers are then held in SI (pint's base units, which are SI for every scene kind) and
 written into member scenes with the SI unit of the key's kind ("65000000.0 Pa") when they were given with
 units, as plain numbers otherwise. A key that takes text (``proppant[0].size = "40/70"``) can vary over
-``values`` of text, kept as written.
+``values`` of text, kept as written. Each [[vary]] knows the kind of its values (:data:`hfgpu.units.SI_UNITS`):
+that of the first value given with units, else the kind its keys take (found by parsing; "dimensionless" for a
+plain ratio or count), "" for text.
 
 Errors are :class:`SweepError`: one line naming the sweep key, the value found and what is allowed.
 """
@@ -53,14 +57,19 @@ class SweepError(SceneError):
         return "sweep" + super().__str__()[len("scene"):]
 
 
+Steps = tuple[tuple[str, int | None], ...]   # a key path split: ("rock", None), ("layers", 0), ...
+
+
 @dataclass(frozen=True)
 class Vary:
-    """One varied scene key: ``values`` (SI numbers; integers and text as written) or a ``distribution``
-    with its ``params`` in SI (the order of DISTRIBUTIONS)."""
+    """One ``[[vary]]``: its summary column ``key`` (the key path; for ``keys``, ``name``), the scene keys it sets
+    to the member's one value (``targets``: (key path, steps) each), ``values`` (SI numbers; integers and text as
+    written) or a ``distribution`` with its ``params`` in SI (the order of DISTRIBUTIONS)."""
 
     key: str
-    steps: tuple[tuple[str, int | None], ...]   # the key path split: ("rock", None), ("layers", 0), ...
+    targets: tuple[tuple[str, Steps], ...]
     unit: str = ""                               # the SI unit member values are written with ("" : bare)
+    kind: str = ""                               # the kind of the values (hfgpu.units.SI_UNITS); "" for text
     distribution: str | None = None
     params: tuple[float, ...] = ()
     values: tuple[float | int | str, ...] = ()
@@ -125,10 +134,7 @@ def _parse(top: Table, path: Path, source: str) -> Sweep:
     vary = tuple(_parse_vary(t, scene_data) for t in top.tables("vary"))
     if not vary:
         raise SweepError("vary", top.data.get("vary", MISSING), "at least one [[vary]] table is required")
-    keys = [v.key for v in vary]
-    for i, key in enumerate(keys):
-        if key in keys[:i]:
-            raise SweepError(f"vary[{i}].key", key, f"each key may be varied once (also vary[{keys.index(key)}])")
+    _check_once(vary)
     if design == "grid":
         for i, v in enumerate(vary):
             if not v.values:
@@ -152,9 +158,23 @@ def _parse(top: Table, path: Path, source: str) -> Sweep:
                  members=members, seed=seed, vary=vary, metrics=tuple(dict.fromkeys(names)))
 
 
+def _check_once(vary: tuple[Vary, ...]) -> None:
+    """Each scene key varied by one [[vary]] only, and each summary column named once."""
+    seen: dict[str, int] = {}
+    for i, v in enumerate(vary):
+        for j, (key, _) in enumerate(v.targets):
+            where = f"vary[{i}].key" if len(v.targets) == 1 and v.key == key else f"vary[{i}].keys[{j}]"
+            if key in seen:
+                raise SweepError(where, key, f"each key may be varied once (also vary[{seen[key]}])")
+            seen[key] = i
+    names = [v.key for v in vary]
+    for i, name in enumerate(names):
+        if name in names[:i]:
+            raise SweepError(f"vary[{i}].name", name, f"each column name once (also vary[{names.index(name)}])")
+
+
 def _parse_vary(t: Table, scene_data: dict) -> Vary:
-    key = t.string("key")
-    steps = split_key(key, t.key_path("key"), scene_data, SweepError, "base scene")
+    column, targets = _targets(t, scene_data)
     if t.has("values"):
         if t.has("distribution"):
             raise SweepError(t.key_path("distribution"), t.raw("distribution"), "give either values or a "
@@ -162,9 +182,10 @@ def _parse_vary(t: Table, scene_data: dict) -> Vary:
         raw = t.raw("values")
         if not isinstance(raw, list) or not raw:
             raise SweepError(t.key_path("values"), raw, "expected a non-empty list of values")
-        values = tuple(_value(t, f"values[{i}]", item, key, steps, scene_data) for i, item in enumerate(raw))
+        values = tuple(_value(t, f"values[{i}]", item, targets, scene_data) for i, item in enumerate(raw))
         t.finish()
-        return Vary(key=key, steps=steps, unit=_unit(raw, values), values=values)
+        kind, unit = _kind(t, raw, values, targets, scene_data)
+        return Vary(key=column, targets=targets, unit=unit, kind=kind, values=values)
     distribution = t.choice("distribution", tuple(DISTRIBUTIONS))
     names = DISTRIBUTIONS[distribution]
     params = []
@@ -173,14 +194,34 @@ def _parse_vary(t: Table, scene_data: dict) -> Vary:
         if name == "std":
             params.append(_std(t, raw, t.raw("mean")))
         else:
-            params.append(_value(t, name, raw, key, steps, scene_data))
+            params.append(_value(t, name, raw, targets, scene_data))
             if isinstance(params[-1], str):
                 raise SweepError(t.key_path(name), raw, "a distribution needs numbers; list text values as "
                                  "values = [...]")
     t.finish()
     _check_params(t, distribution, dict(zip(names, params)))
-    return Vary(key=key, steps=steps, unit=_unit([t.data[n] for n in names], params), distribution=distribution,
+    kind, unit = _kind(t, [t.data[n] for n in names], params, targets, scene_data)
+    return Vary(key=column, targets=targets, unit=unit, kind=kind, distribution=distribution,
                 params=tuple(float(p) for p in params))
+
+
+def _targets(t: Table, scene_data: dict) -> tuple[str, tuple[tuple[str, Steps], ...]]:
+    """(summary column, ((key path, steps), ...)) of a [[vary]]: its ``key``, or its ``keys`` and ``name``."""
+    if not t.has("keys"):
+        key = t.string("key")
+        return key, ((key, split_key(key, t.key_path("key"), scene_data, SweepError, "base scene")),)
+    keys = t.raw("keys")
+    if t.has("key"):
+        raise SweepError(t.key_path("key"), t.raw("key"), "give either key or keys, not both")
+    if not isinstance(keys, list) or not keys or not all(isinstance(k, str) for k in keys):
+        raise SweepError(t.key_path("keys"), keys, 'expected a non-empty list of scene key paths, e.g. '
+                         '["injection.schedule[0].rate", "injection.schedule[1].rate"]')
+    for i, key in enumerate(keys):
+        if key in keys[:i]:
+            raise SweepError(t.key_path(f"keys[{i}]"), key, f"listed twice (also keys[{keys.index(key)}])")
+    targets = tuple((key, split_key(key, t.key_path(f"keys[{i}]"), scene_data, SweepError, "base scene"))
+                    for i, key in enumerate(keys))
+    return t.string("name", "+".join(keys)), targets
 
 
 def _check_params(t: Table, distribution: str, p: dict[str, float]) -> None:
@@ -200,38 +241,89 @@ def si_number(raw: Any) -> float:
     return float(registry().Quantity(raw.strip()).to_base_units().magnitude)
 
 
-def _unit(raw: list[Any], values) -> str:
-    """The SI unit (hfgpu.units.SI_UNITS) of the first value given with units ("" when none is: numbers, text)."""
-    ureg = registry()
-    for text, value in zip(raw, values):
-        if isinstance(text, str) and not isinstance(value, str):
-            dimension = ureg.Quantity(text.strip()).dimensionality
-            for unit in SI_UNITS.values():
-                if unit and ureg.Quantity(1.0, unit).dimensionality == dimension:
-                    return unit
-    return ""
-
-
-def _value(t: Table, name: str, raw: Any, key: str, steps, scene_data: dict) -> float | int | str:
-    """``raw`` checked as a value of the scene key (parsed in the base scene) and returned in SI; text that the
-    key takes as text (a sieve class, "40/70") is returned as it is."""
+def _value(t: Table, name: str, raw: Any, targets, scene_data: dict) -> float | int | str:
+    """``raw`` checked as a value of each target key (parsed in the base scene) and returned in SI; text that the
+    keys take as text (a sieve class, "40/70") is returned as it is."""
     where = t.key_path(name)
     if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
         raise SweepError(where, raw, "expected a number (SI) or a string with units, e.g. \"65 MPa\"")
+    for i, (key, steps) in enumerate(targets):
+        key_where = t.key_path("key" if t.has("key") else f"keys[{i}]")
+        _check_value(where, raw, key, steps, scene_data, key_where, len(targets) > 1)
+    if not isinstance(raw, str):
+        return raw if type(raw) is int else float(raw)
+    try:
+        number, unit = si_number(raw), SI_UNITS[_dimension_kind(raw)]
+    except Exception:  # not a quantity (pint raises several types): the text is the value
+        return raw
+    written = f"{number!r} {unit}" if unit else number   # as members.py writes it
+    return number if _accepts(scene_data, tuple(steps for _, steps in targets), written) else raw
+
+
+def _check_value(where: str, raw: Any, key: str, steps: Steps, scene_data: dict, key_where: str,
+                 several: bool) -> None:
+    """The scene's message for ``raw`` at the scene key ``key``, raised as a :class:`SweepError` at ``where`` (at
+    ``key_where`` when the key itself is unknown); with ``several`` keys, the message names the key."""
     try:
         parse_scene(with_value(scene_data, steps, raw))
     except SceneError as exc:
         if exc.path == key and exc.allowed.startswith("unknown key"):  # the key itself is wrong, not the value
-            raise SweepError(t.key_path("key"), key, exc.allowed) from None
-        raise SweepError(where, raw, exc.allowed if exc.path == key else str(exc)) from None
-    if not isinstance(raw, str):
-        return raw if type(raw) is int else float(raw)
+            raise SweepError(key_where, key, exc.allowed) from None
+        why = exc.allowed if exc.path == key else str(exc)
+        raise SweepError(where, raw, f"for key '{key}': {why}" if several else why) from None
+
+
+def _kind(t: Table, raw: list[Any], values, targets, scene_data: dict) -> tuple[str, str]:
+    """(kind, unit) of a [[vary]]'s values: the kind (hfgpu.units.SI_UNITS) of the first value given with units
+    and its SI unit, the unit member values are written with; for plain numbers, the kind every key takes (a
+    :class:`SweepError` when the keys differ) and "" (written bare); ("", "") for text."""
+    for text, value in zip(raw, values):
+        if isinstance(text, str) and not isinstance(value, str):
+            kind = _dimension_kind(text)
+            return kind, SI_UNITS[kind]
+    numbers = [v for v in values if not isinstance(v, str)]
+    if not numbers:
+        return "", ""
+    kinds = [_key_kind(steps, numbers[0], scene_data) for _, steps in targets]
+    for (key, _), kind in zip(targets[1:], kinds[1:]):
+        if kind != kinds[0]:
+            raise SweepError(t.key_path("keys"), key, f"takes {_kind_text(kind)} where '{targets[0][0]}' takes "
+                             f"{_kind_text(kinds[0])}: the keys of one [[vary]] get one value, so they must take the "
+                             "same kind")
+    return kinds[0], ""
+
+
+def _kind_text(kind: str) -> str:
+    """"a pressure (Pa)", "a plain number" for a dimensionless kind."""
+    return f"a {kind.replace('_', ' ')} ({SI_UNITS[kind]})" if SI_UNITS[kind] else "a plain number"
+
+
+def _dimension_kind(text: str) -> str:
+    """The first kind of hfgpu.units.SI_UNITS whose unit has the dimension of the quantity ``text``."""
+    ureg = registry()
+    dimension = ureg.Quantity(text.strip()).dimensionality
+    return next((kind for kind, unit in SI_UNITS.items() if ureg.Quantity(1.0, unit).dimensionality == dimension),
+                "dimensionless")
+
+
+def _key_kind(steps: Steps, number: float | int, scene_data: dict) -> str:
+    """The kind a scene key takes: the first kind of hfgpu.units.SI_UNITS whose SI unit the base scene accepts
+    after ``number`` at the key ("dimensionless" when none is)."""
+    for kind, unit in SI_UNITS.items():
+        if unit and _accepts(scene_data, (steps,), f"{number!r} {unit}"):
+            return kind
+    return "dimensionless"
+
+
+def _accepts(scene_data: dict, paths: tuple[Steps, ...], value: Any) -> bool:
+    """Whether the base scene with ``value`` at every key path of ``paths`` parses."""
+    for steps in paths:
+        scene_data = with_value(scene_data, steps, value)
     try:
-        number = si_number(raw)
-        parse_scene(with_value(scene_data, steps, number))
-    except Exception:  # not a quantity (pint raises several types), or the key wants text: the text is the value
-        return raw
-    return number
+        parse_scene(scene_data)
+    except SceneError:
+        return False
+    return True
 
 
 def _std(t: Table, raw: Any, mean: Any) -> float:

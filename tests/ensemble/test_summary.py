@@ -12,6 +12,7 @@ import hfgpu
 from hfgpu.ensemble.plots import plot_ensemble
 from hfgpu.ensemble.summary import (columns, common_fraction, percentiles, read_csv, read_ensemble, write_csv,
                                     write_ensemble)
+from hfgpu.ensemble.table_units import ColumnUnits, column_kinds
 from hfgpu.records import GridFrame
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -30,8 +31,10 @@ def test_tables_round_trip_numbers_nan_and_text(tmp_path):
              "propped_area": 123.456789012345, "wall_seconds": 1.5},
             {"id": "0001", "status": "failed: Newton, after 3 retries", "proppant[0].size": "100 mesh",
              "rock.min_stress": 6.2e7, "propped_area": float("nan"), "wall_seconds": 0.25}]
-    write_csv(tmp_path / "summary.csv", header, rows)
-    write_ensemble(tmp_path / "ensemble.h5", "seed = 1", header, rows, ["propped_area"], None)
+    units = ColumnUnits(column_kinds({"proppant[0].size": "", "rock.min_stress": "pressure"}, ["propped_area"]),
+                        "SI", stored=True)
+    write_csv(tmp_path / "summary.csv", header, rows, units)
+    write_ensemble(tmp_path / "ensemble.h5", "seed = 1", header, rows, ["propped_area"], None, units)
     for back in (read_csv(tmp_path / "summary.csv"), read_ensemble(tmp_path / "ensemble.h5")["rows"]):
         assert [list(r) for r in back] == [header, header]
         assert back[0] == rows[0]
