@@ -34,11 +34,15 @@ from hfgpu.propped import GROUPS, created_area, packed_fraction, parcel_groups, 
 
 #: "Converged" here: the propped area within this share of the finest grid's.
 TOLERANCE = 0.05
+#: Parcels per cell on every grid (balanced's value; so 4x the parcels per halving of the cells).
+PARCELS_PER_CELL = 16
 
 
 def scene_for(cells: float, end: float, size: str | None):
-    """The base case with proppant cells of ``cells`` m, run to ``end`` s."""
-    return edit_scene(load(False, None, size), {"coupling.cell_size": f"{cells:g} m", "run.end_time": f"{end:g} s"})
+    """The base case with proppant cells of ``cells`` m, run to ``end`` s, at 16 parcels per cell (the preset's
+    default: a grid study holds the parcels per cell, not the parcel budget a scene without it gets)."""
+    return edit_scene(load(False, None, size), {"coupling.cell_size": f"{cells:g} m", "run.end_time": f"{end:g} s",
+                                                "mppic.parcels_per_cell": PARCELS_PER_CELL})
 
 
 def run_grid(cells: float, out: Path, end: float, size: str | None, reuse: bool) -> Path:
