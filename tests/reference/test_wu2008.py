@@ -1,4 +1,5 @@
-"""Wu et al. (2008) digitised fronts against the REFERENCE.md section 4 table (data from ../shared)."""
+"""Wu et al. (2008) digitised fronts (PyFrac's examples/wu_et_al_data.csv, read from ../shared) against their
+extents tabulated independently from that csv."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import pytest
 
 from hfgpu.reference import wu2008 as wu
 
-# REFERENCE.md 4: t -> (up, down, left, right) in mm, relative to the injection point
+# extents of the csv's fronts: t -> (up, down, left, right) in mm, relative to the injection point
 TABLE = {22.0: (15.0, 18.4, 19.2, 15.8), 60.0: (30.0, 46.3, 41.0, 38.5), 144.0: (34.3, 94.7, 68.8, 65.4),
          376.0: (34.3, 132.9, 101.7, 92.7), 665.0: (34.7, 163.7, 127.8, 118.4)}
 
@@ -34,7 +35,7 @@ def test_front_is_contained_above_and_grows_down(fronts):
 
 
 def test_injected_volume_of_paper_schedule():
-    # REFERENCE.md 4: 0.0198, 0.2164, 0.7624, 1.3254, 1.9901 mL
+    # PyFrac Experiment_Wu_et_al.py schedule integrated independently: 0.0198, 0.2164, 0.7624, 1.3254, 1.9901 mL
     np.testing.assert_allclose(wu.injected_volume([22.0, 60.0, 144.0, 376.0, 665.0]),
                                np.array([0.0198, 0.2164, 0.7624, 1.3254, 1.9901]) * 1e-6, rtol=2e-4)
     assert float(wu.injected_volume(1000.0)) == pytest.approx(
