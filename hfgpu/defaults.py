@@ -11,8 +11,8 @@ schedule, scaled by the preset's ``time_scale`` s (fast 2, balanced 1, accurate 
   parcels' own) bind below it;
 * ``[mppic] max_parcels`` = the preset's ``parcel_budget`` when ``parcels_per_cell`` is not given: the
   particles per parcel are then raised so that the schedule's proppant makes at most that many parcels
-  (:func:`hfgpu.proppant.simulator.particles_per_parcel`), so a long treatment's cost per step stays bounded and
-  its wall time grows linearly with the pumped time.
+  (:func:`hfgpu.proppant.simulator.particles_per_parcel`), so a long treatment's particle cost per step stays
+  bounded.
 
 A scene that gives a key keeps its value. Scenes without a fracture (lab cells, columns, slots) keep the preset's
 constants. ``hfgpu check`` prints each value with its reason (:func:`hfgpu.presets.knob_report`).
