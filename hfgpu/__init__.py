@@ -23,7 +23,7 @@ from .scene_text import edit_scene
 if TYPE_CHECKING:
     from .io.results import Results
 
-__version__ = "0.1.0"
+from .version import __version__
 
 
 def run(scene: Scene | str | Path, out: str | Path, *, progress: bool = True, rrd: str | Path | None = None,

@@ -13,7 +13,7 @@ import signal
 import sys
 from pathlib import Path
 
-from . import __version__
+from .version import __version__
 from .errors import HfgpuError
 from .interrupts import signal_number
 

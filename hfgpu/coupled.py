@@ -43,70 +43,21 @@ import math
 import time as _time
 import warnings
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 
 from .coupling import FractureHistory, bridging_risk, proppant_frame
+from .coupling_config import DEFAULT_INLET_CELLS
 from .errors import SceneError
 from .fracture.mesh import injection_cell_centre
 from .fracture.simulator import simulate as simulate_fracture
 from .io.progress import shifted
+from .io.sink import FractureSink, ProppantSink, ResultsSink
 from .proppant.config import Geometry, Port
 from .proppant.simulator import ProppantSimulation, warn_screen_out
-from .records import GridFrame, ProppantSnapshot, SolidBalanceRecord
+from .records import FractureSnapshot, GridFrame, ProppantSnapshot, SolidBalanceRecord
 from .scene import Scene, Schedule
-from .scene_reader import Table
-
-#: Snapshots of the fracture per run when ``fracture_every`` is not given.
-DEFAULT_FRACTURE_SNAPSHOTS = 60
-#: Default outer radius of the inlet annulus, in (larger) proppant cell sizes.
-DEFAULT_INLET_CELLS = 1.5
-#: Default ``[coupling] min_width`` [m]: narrower cells are closed for the proppant run (parse_coupling).
-DEFAULT_MIN_WIDTH = 10e-6
-
-
-@dataclass(frozen=True)
-class CouplingConfig:
-    """``[coupling]``: how the proppant run reads the fracture (see the module docstring)."""
-
-    fracture_every: float
-    cell_size: tuple[float, float] | None = None
-    inlet_inner_radius: float = 0.0
-    inlet_radius: float | None = None
-    proppant_start: float | None = None
-    margin: int = 1
-    min_width: float = DEFAULT_MIN_WIDTH
-
-
-def parse_coupling(t: Table, end_time: float, refinement: float = 1.0) -> CouplingConfig:
-    """Read ``[coupling]`` (every key optional) into a :class:`CouplingConfig`; the proppant cells in use are
-    ``cell_size`` / ``refinement`` (``[mesh] refinement``, as the fracture cells).
-
-    ``min_width``: proppant cells narrower than this are closed for the proppant run. A cell that opens between
-    two fracture snapshots passes through every width from 0 (the width is linear in time), and the fluid must
-    supply the leak-off of its faces: u ~ 2 q_L dx / w, ~300 m/s at w = 20 nm (measured on 2.5 m cells of the
-    field case), so the fluid Courant limit (Eq. 42) stops the run. At the default 10 um, u ~ 0.05 m/s for
-    q_L = 1e-7 m/s on 2.5 m cells; the fluid such cells hold (w dx dz) is dropped as in any closing cell."""
-    positive = dict(minimum=0.0, exclusive_minimum=True)
-    every = t.quantity("fracture_every", "time", end_time / DEFAULT_FRACTURE_SNAPSHOTS, **positive)
-    size = t.raw("cell_size", None)
-    cell_size = None
-    if size is not None:
-        items = size if isinstance(size, list) else [size, size]
-        if len(items) != 2:
-            raise SceneError(t.key_path("cell_size"), size, 'expected one length or two, ["dx", "dz"]')
-        cell_size = tuple(Table({"cell_size": s}, t.path).quantity("cell_size", "length", **positive)
-                          / refinement for s in items)
-    inner = t.quantity("inlet_inner_radius", "length", 0.0, minimum=0.0)
-    outer = t.quantity("inlet_radius", "length", None, minimum=inner, exclusive_minimum=True)
-    start = t.quantity("proppant_start", "time", None, minimum=0.0, maximum=end_time, exclusive_maximum=True)
-    margin = t.integer("margin", 1, minimum=0)
-    min_width = t.quantity("min_width", "length", DEFAULT_MIN_WIDTH, minimum=0.0)
-    t.finish()
-    return CouplingConfig(fracture_every=every, cell_size=cell_size, inlet_inner_radius=inner,
-                          inlet_radius=outer, proppant_start=start, margin=margin, min_width=min_width)
-
 
 def proppant_start_time(scene: Scene) -> float:
     """When the proppant run starts: ``[coupling] proppant_start``, else the start of the first stage that
@@ -214,12 +165,12 @@ class Timings:
 class _FractureTee:
     """Sink of the fracture phase: records go on to ``sink``; snapshots are also kept in ``snapshots``."""
 
-    def __init__(self, sink: Any, timings: Timings):
-        self.snapshots: list = []
+    def __init__(self, sink: FractureSink, timings: Timings):
+        self.snapshots: list[FractureSnapshot] = []
         self._snap = timings.wrap("io", sink.fracture_snapshot)
         self.fracture_balance = timings.wrap("io", sink.fracture_balance)
 
-    def fracture_snapshot(self, snap) -> None:
+    def fracture_snapshot(self, snap: FractureSnapshot) -> None:
         self.snapshots.append(snap)
         self._snap(snap)
 
@@ -227,7 +178,7 @@ class _FractureTee:
 class _ProppantShift:
     """Sink of the proppant phase: times moved back by ``start``, ``bridging_risk`` added to the grid."""
 
-    def __init__(self, sink: Any, start: float, factor: float, timings: Timings):
+    def __init__(self, sink: ProppantSink, start: float, factor: float, timings: Timings):
         self.start, self.factor = start, factor
         self._snap = timings.wrap("io", sink.proppant_snapshot)
         self._balance = timings.wrap("io", sink.proppant_balance)
@@ -280,7 +231,7 @@ def warn_inconsistent_width(summary: dict) -> None:
                       "snapshots; coarse cells)", RuntimeWarning, stacklevel=3)
 
 
-def simulate(scene: Scene, sink: Any, progress: Callable[[float], None] | None = None,
+def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] | None = None,
              timings: Timings | None = None, checkpoint=None, resume: dict | None = None) -> dict:
     """Run the coupled scene (module docstring): fracture, then proppant on the fracture history.
 

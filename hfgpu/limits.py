@@ -63,13 +63,13 @@ def check_engine_start(scene) -> None:
 
     engine = importlib.import_module("hfgpu.fracture.simulator")
     if hasattr(engine, "start_time"):  # (a stand-in simulator of the tests has neither check)
-        engine._check_scene(scene)
+        engine.check_scene(scene)
         _start_check(scene, engine)
 
 
 def _start_check(scene, engine) -> None:
     """The starting radial fracture (``fracture.initial_radius_cells`` x the larger cell in use) must form, at the
-    schedule's rates, within half the schedule and while a stage injects (as :class:`hfgpu.fracture.simulator._Engine`
+    schedule's rates, within half the schedule and while a stage injects (as :func:`hfgpu.fracture.simulator.simulate`
     requires)."""
     import math
 

@@ -45,10 +45,9 @@ from typing import Any
 
 import numpy as np
 
+from .closure.pack import PACKED_SPEED
 from .records import ProppantSnapshot
 
-#: Parcels slower than this [m/s] count as packed.
-PACKED_SPEED = 1e-3
 #: The groups of :func:`parcel_groups`, in print order.
 GROUPS = ("suspended", "moving bed", "bed at rest", "bridged")
 #: Times [s] of the paper's probability plots (Fig. 16).

@@ -19,31 +19,22 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .errors import HfgpuError
+from .simulators import SIMULATORS, NotSupportedError, check_supported
 from .interrupts import signal_number, stop_signals_interrupt
+from .io.sink import METHODS, FractureSink, ProppantSink
 from .scene import Scene
 from .scene_checks import validate
 from .threads import blas_thread_limit, blas_threads
 
-#: The module whose ``simulate(scene, sink, progress=None, checkpoint=None, resume=None) -> dict`` runs each
-#: physics set.
-SIMULATORS = {("fracture",): "hfgpu.fracture.simulator", ("proppant",): "hfgpu.proppant.simulator",
-              ("fracture", "proppant"): "hfgpu.coupled"}
-
-SINK_METHODS = ("fracture_snapshot", "fracture_balance", "proppant_snapshot", "proppant_balance")
-
-
-class NotSupportedError(HfgpuError, NotImplementedError):
-    """The scene asks for something this version does not run yet."""
-
-
 class FanOut:
-    """A sink that hands every record to each of ``sinks`` that has the method, in order."""
+    """A sink (hfgpu.io.sink.ResultsSink) that hands every record to each of ``sinks`` that has the method, in
+    order."""
 
-    def __init__(self, sinks: list[Any]):
+    def __init__(self, sinks: list[FractureSink | ProppantSink]):
         self.sinks = list(sinks)
 
     def __getattr__(self, name: str) -> Callable[[Any], None]:
-        if name not in SINK_METHODS:
+        if name not in METHODS:
             raise AttributeError(name)
         targets = [getattr(sink, name) for sink in self.sinks if hasattr(sink, name)]
 
@@ -69,13 +60,6 @@ def warn_edited(scene: Scene) -> None:
         warnings.warn("the scene was changed after it was read (Scene.replace): the results file stores the text "
                       "it was read from, which does not describe this run; change keys with hfgpu.edit_scene",
                       UserWarning, stacklevel=3)
-
-
-def check_supported(scene: Scene) -> None:
-    """Raise :class:`NotSupportedError` for a physics set this version cannot run."""
-    if tuple(scene.run.physics) not in SIMULATORS:
-        raise NotSupportedError(f"run.physics = {list(scene.run.physics)}: allowed sets are "
-                                f"{[list(k) for k in SIMULATORS]}")
 
 
 def simulator_for(scene: Scene) -> Callable[..., dict]:
@@ -125,7 +109,7 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     else:
         writer, start = ResultsWriter(out, scene), 0.0
     checkpoint = Checkpointer(writer.write_checkpoint, checkpoint_interval(scene), start)
-    sinks: list[Any] = [writer]
+    sinks: list[FractureSink | ProppantSink] = [writer]
     try:
         if rrd is not None or view or connect is not None:
             from .io.rerun_view import RerunRecorder

@@ -417,7 +417,7 @@ def _parse(data: dict, source: str) -> Scene:
         if run is None or mesh is None:
             sections.skip("coupling")
         else:
-            from .coupled import parse_coupling
+            from .coupling_config import parse_coupling
 
             coupling = sections(("coupling",), lambda: parse_coupling(top.table("coupling", {}), run.end_time,
                                                                        mesh.refinement))

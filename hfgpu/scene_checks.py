@@ -47,7 +47,7 @@ def validate(scene_or_path: Scene | str | Path) -> Scene:
     """The scene (read from a path or TOML text, or as given) checked as ``hfgpu run`` checks it, with every
     warning in ``Scene.warnings``; raises :class:`SceneError` (a ``SceneErrors`` for several) otherwise."""
     from .limits import check_engine_start, check_limits
-    from .runner import check_supported
+    from .simulators import check_supported
 
     scene = scene_or_path if isinstance(scene_or_path, Scene) else load_scene(scene_or_path)
     check_supported(scene)

@@ -14,9 +14,13 @@ from hfgpu.kernels.layout import (F_BETA, F_FORCE, M_MASS, M_VOLUME, MEAN_U, MEA
                                   ST_SPEED, ST_VOLUME)
 from hfgpu.kernels.runtime import ti
 
-#: what crosses to the host after a sub-loop and after a scatter, in this order
-FACE_OUT = (F_FORCE, F_BETA)
-CELL_OUT = (THETA, M_VOLUME, M_MASS, MEAN_U, MEAN_V, VARIANCE, SAUTER)
+#: what crosses to the host, by the name the host gives it: after a sub-loop, these channels of both face sets
+#: (hfgpu.proppant.engine_seam.SubLoop's force_x, beta_z, ...); after a scatter, these cell channels
+#: (the fields of hfgpu.proppant.particle_ops_numpy.CellMoments)
+FACE_OUT = dict(force=F_FORCE, beta=F_BETA)
+CELL_OUT = dict(volume_fraction=THETA, solid_volume=M_VOLUME, mass=M_MASS, mean_u=MEAN_U, mean_v=MEAN_V,
+                velocity_variance=VARIANCE, sauter_radius=SAUTER)
+_FACE_CHANNELS, _CELL_CHANNELS = tuple(FACE_OUT.values()), tuple(CELL_OUT.values())  # read_channels' static tuples
 
 F1 = ti.types.ndarray(dtype=ti.f64, ndim=1)
 F2 = ti.types.ndarray(dtype=ti.f64, ndim=2)
@@ -151,8 +155,8 @@ def read_channels(G: ti.template(), channels: ti.template(), out: ti.template())
 def read_faces(XF: F3, ZF: F3, ST: F1, xfaces: F3, zfaces: F3, stats: F1):
     """The sub-loop's face means F and beta (FACE_OUT) and the reports into the host's copies (xfaces, zfaces,
     stats: NUMPY)."""
-    read_channels(XF, FACE_OUT, xfaces)
-    read_channels(ZF, FACE_OUT, zfaces)
+    read_channels(XF, _FACE_CHANNELS, xfaces)
+    read_channels(ZF, _FACE_CHANNELS, zfaces)
     for j in ST:
         stats[j] = ST[j]
 
@@ -160,6 +164,6 @@ def read_faces(XF: F3, ZF: F3, ST: F1, xfaces: F3, zfaces: F3, stats: F1):
 @ti.kernel
 def read_cells(C: F3, ST: F1, cells: F3, stats: F1):
     """The cell moments the host uses (CELL_OUT) and the reports into the host's copies (cells, stats: NUMPY)."""
-    read_channels(C, CELL_OUT, cells)
+    read_channels(C, _CELL_CHANNELS, cells)
     for j in ST:
         stats[j] = ST[j]

@@ -1,8 +1,9 @@
 """Where the MP-PIC engine keeps its state on the device: rows and channels of its Taichi ndarrays.
 
-Plain Python (no Taichi import): the kernels and the host engine (hfgpu.proppant.engine_taichi) share these
-numbers. Every array is allocated once per engine (the parcel arrays again when the capacity grows) and
-reused; the row of a field is contiguous (structure of arrays).
+Plain Python (no Taichi import): the kernels, the host engine (hfgpu.proppant.engine_taichi) and the host's
+parcels (hfgpu.proppant.parcels: their fields and states) share these names and numbers. Every array is
+allocated once per engine (the parcel arrays again when the capacity grows) and reused; the row of a field is
+contiguous (structure of arrays).
 
 Parcels (capacity ``cap``; the first ``n`` columns are in use):
     P (PARCEL_ROWS, cap) float64: X, Z [m], U, V [m/s], RADIUS [m], DENSITY [kg/m^3], PARTICLES (per parcel)
@@ -25,12 +26,15 @@ sub-loop's outflow [m^3], parcels that left (ST_LEFT) and largest |u| + |v|, the
 sort's kept and dropped counts, the solid volume in the domain.
 """
 
-# parcel rows (P)
-X, Z, U, V, RADIUS, DENSITY, PARTICLES = range(7)
-PARCEL_ROWS = 7
-# parcel integer rows (S)
-STATE, CLASS = range(2)
-STATE_ROWS = 2
+# parcel rows (P): the float fields of hfgpu.proppant.parcels.Parcels, which builds its fields from these names
+FLOAT_FIELDS = ("x", "z", "u", "v", "radius", "density", "particles")
+X, Z, U, V, RADIUS, DENSITY, PARTICLES = range(len(FLOAT_FIELDS))
+PARCEL_ROWS = len(FLOAT_FIELDS)
+# parcel integer rows (S): the integer fields of Parcels
+INT_FIELDS = ("state", "class_id")
+STATE, CLASS = range(len(INT_FIELDS))
+STATE_ROWS = len(INT_FIELDS)
+# parcel states (the STATE row, Parcels.state)
 SUSPENDED, BRIDGED, GONE = 0, 1, 2
 # per-parcel work rows (W): the SEEN rows first
 S_UF, S_VF, S_DPDX, S_DPDZ, S_DTDX, S_DTDZ, S_THETA, S_MEAN_U, S_MEAN_V, S_DAMPING, S_WIDTH = range(11)

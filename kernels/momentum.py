@@ -9,8 +9,7 @@ component runs the x kernel on the transposed grid. Inputs and outputs are NumPy
 import numpy as np
 
 from hfgpu.kernels.runtime import init, ti
-from hfgpu.proppant.momentum import DEAN_COEFFICIENT
-from hfgpu.proppant.params import wall_friction_code
+from hfgpu.kernels.wall_friction import DEAN_COEFFICIENT, wall_friction_code
 
 F64_2D = ti.types.ndarray(dtype=ti.f64, ndim=2)
 

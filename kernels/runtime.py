@@ -20,7 +20,8 @@ import os
 os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "False")
 import taichi as ti  # noqa: E402 (after the banner setting)
 
-from hfgpu.proppant.config import ARCHES
+from hfgpu.kernels.arches import ARCHES
+
 _state: dict[str, str] = {}
 
 
@@ -71,4 +72,4 @@ def thread_count() -> int | None:
     return int(ti.lang.impl.current_cfg().cpu_max_num_threads)
 
 
-__all__ = ["ti", "init", "thread_count", "ARCHES"]
+__all__ = ["ti", "init", "thread_count"]

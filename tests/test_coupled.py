@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 from hfgpu import load_scene, open_results, run
-from hfgpu.coupled import (CouplingConfig, late_start, proppant_start_time, screen_out_cells, shifted_schedule)
+from hfgpu.coupled import late_start, proppant_start_time, screen_out_cells, shifted_schedule
 from hfgpu.coupling import FractureHistory
+from hfgpu.coupling_config import CouplingConfig
 from hfgpu.errors import SceneError
 from hfgpu.scene import Schedule, Stage
 

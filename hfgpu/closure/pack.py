@@ -12,7 +12,7 @@ the walls close between the grains).
 
 Settling at shut-in (``[closure] settling``): "in_place" closes the walls on every grain where the snapshot
 has it; "bed" (default) first lets the suspended grains (:func:`hfgpu.propped.packed_fraction`'s rule: not
-bridged and faster than :data:`hfgpu.propped.PACKED_SPEED`) fall down their column of cells onto the bed below:
+bridged and faster than :data:`PACKED_SPEED`) fall down their column of cells onto the bed below:
 in each run of open cells of a column, the run's suspended solids fill the room left in its cells (phi_s w A
 less the packed solids already there) from the deepest cell upward, with the run's grain mix in every cell
 they reach; what the run cannot hold stays where it was. "bed" is the default because a slickwater fracture
@@ -26,8 +26,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..propped import PACKED_SPEED
 from ..records import ProppantSnapshot
+
+#: Parcels slower than this [m/s] count as packed (hfgpu.propped's groups use the same speed).
+PACKED_SPEED = 1e-3
 
 
 @dataclass(frozen=True)

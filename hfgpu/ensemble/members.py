@@ -40,7 +40,7 @@ def members(sweep: Sweep) -> list[Member]:
     """Every member of the sweep, each scene parsed and checked as ``hfgpu run`` would before any work
     (:class:`MemberError` names the first bad one)."""
     from ..limits import check_limits
-    from ..runner import check_supported
+    from ..simulators import check_supported
     from ..scene import load_scene
 
     out = []

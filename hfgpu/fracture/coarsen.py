@@ -34,7 +34,13 @@ normals (where it has none, minus the sum of its fine cells' offsets from its ce
 areas: the direction of its dry part), and its advance the one whose plane front wets that fraction
 (tip_cells.advance_for_fill).
 
-Public API: ``coarsen(ix, iz, source=(0, 0), factor=3) -> Coarsening``, ``coarse_front``.
+The engine's fields move onto the coarse grid by ``coarse_grid`` (widths and rates by ``width``, the leaked
+volumes by ``total / f^2``, pressure by ``mean``, opening and arrival times by ``earliest``, the time the front
+crosses a cell by the latest fine cell's), with the front's ``fill`` and ``advance`` from ``coarse_front`` or,
+where no sub-grid front is carried, ``channel_front``.
+
+Public API: ``coarsen(ix, iz, source=(0, 0), factor=3) -> Coarsening``, ``coarse_front``, ``channel_front``,
+``coarse_grid``.
 """
 
 from __future__ import annotations
@@ -43,6 +49,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .mesh import GROW, Grid
 from .tip_cells import advance_for_fill
 
 
@@ -156,3 +163,33 @@ def coarse_front(c: Coarsening, ix: np.ndarray, iz: np.ndarray, fill: np.ndarray
     advance = np.full(fill_c.shape, np.nan)
     advance[tip] = advance_for_fill(fill_c[tip], vx[tip], vz[tip], f * dx, f * dz)
     return np.where(tip, fill_c, 1.0), advance
+
+
+def channel_front(c: Coarsening) -> tuple[np.ndarray, np.ndarray]:
+    """(fill, advance) of coarse cells that carry no sub-grid front: every cell wholly wetted (a channel cell)
+    and its advance unknown (NaN) until the next step places the front."""
+    return np.ones(c.ix.size), np.full(c.ix.size, np.nan)
+
+
+def coarse_grid(grid: Grid, c: Coarsening, rows: np.ndarray, cols: np.ndarray, fill: np.ndarray,
+                advance: np.ndarray) -> Grid:
+    """The grid of the coarse cells of ``c`` (cells ``c.factor`` times larger around the same injection point,
+    GROW cells of margin) holding ``grid``'s fields carried by the module docstring's rules; ``rows``, ``cols``:
+    the fine active cells' box indices, in the order given to ``coarsen``; ``fill``, ``advance``: the coarse
+    cells' front (``coarse_front`` or ``channel_front``). Volumes (w, leaked, w_rate) are carried exactly."""
+    f, sel = c.factor, (rows, cols)
+    half = int(max(np.abs(c.ix).max(), np.abs(c.iz).max())) + GROW
+    new = Grid.around_injection(f * grid.dx, f * grid.dz, grid.x_inj, grid.z_inj, half)
+    at = (c.iz + half, c.ix + half)
+    new["active"][at] = True
+    new["w"][at] = c.width(grid["w"][sel])
+    new["p"][at] = c.mean(grid["p"][sel])
+    new["leak_rate"][at] = c.total(grid["leak_rate"][sel]) / f**2
+    new["leaked"][at] = c.total(grid["leaked"][sel]) / f**2
+    new["opened"][at] = c.earliest(grid["opened"][sel])
+    new["reached"][at] = c.earliest(grid["reached"][sel])
+    new["filled"][at] = -c.earliest(-grid["filled"][sel])
+    new["fill"][at] = fill
+    new["advance"][at] = advance
+    new["w_rate"][at] = c.width(grid["w_rate"][sel])
+    return new

@@ -104,8 +104,15 @@ class ElasticityOperator:
         self._table = np.zeros((0, 0))   # C at offset (dk mod Pz, di mod Px)
         self._table_hat = np.zeros((0, 0), dtype=complex)
 
-    def _ensure(self, nz: int, nx: int) -> None:
-        """Grow the kernel table and its rfft2 so that a box of nz x nx cells fits (Eq. 21 tabulated)."""
+    @property
+    def capacity(self) -> tuple[int, int]:
+        """(nz, nx): the largest box of cells the cached kernel table serves. The FFT size, hence the round-off
+        of every product, follows from it, so a restored run reserves the capacity it had (``reserve``)."""
+        return self._capacity
+
+    def reserve(self, nz: int, nx: int) -> None:
+        """Grow the kernel table and its rfft2 so that a box of nz x nx cells fits (Eq. 21 tabulated); the
+        capacity grows by _GROWTH at least, so a growing fracture rebuilds the table a few times only."""
         cz, cx = self._capacity
         if nz <= cz and nx <= cx:
             return
@@ -129,7 +136,7 @@ class ElasticityOperator:
             return ix, iz
         col = ix - ix.min()
         row = iz - iz.min()
-        self._ensure(int(row.max()) + 1, int(col.max()) + 1)
+        self.reserve(int(row.max()) + 1, int(col.max()) + 1)
         return row, col
 
     def matvec(self, ix: np.ndarray, iz: np.ndarray, w: np.ndarray) -> np.ndarray:

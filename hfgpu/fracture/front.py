@@ -22,7 +22,7 @@ time a cell stays dry does not count as Carter exposure, see simulator.py). Open
 never close, so the front cannot retreat.
 
 Sub-grid front. The same asymptote, inverted at the cells on the fracture's edge, locates the front
-inside the grid: the simulator's front summary takes, for each edge cell, its centre's distance from the
+inside the grid: the front summary (views.front_extents) takes, for each edge cell, its centre's distance from the
 injection point plus the inverted distance s (capped at one cell), which measures the radius of a radial
 fracture more finely than whole cells, and the extents up/down/left/right the same way.
 
@@ -98,8 +98,9 @@ def tip_velocity(model: TipModel, v_fluid: np.ndarray, h: float, t: float, reach
     return np.fmax(v_fluid, np.where(np.isfinite(reached), v_front, 0.0))
 
 
-def _shift(a: np.ndarray, dk: int, di: int, fill) -> np.ndarray:
-    """b[k, i] = a[k - dk, i - di] (the neighbour on the -(dk, di) side), ``fill`` outside the box."""
+def shift(a: np.ndarray, dk: int, di: int, fill) -> np.ndarray:
+    """b[k, i] = a[k - dk, i - di]: every cell's neighbour on the -(dk, di) side, ``fill`` outside the box
+    (the neighbour access of the front rules, the level set and the footprint, on whole box arrays)."""
     out = np.full_like(a, fill)
     nz, nx = a.shape
     out[max(dk, 0):nz + min(dk, 0), max(di, 0):nx + min(di, 0)] = \
@@ -111,15 +112,15 @@ def inflow_velocity(active: np.ndarray, w: np.ndarray, p: np.ndarray, h: float, 
                     mu_prime: float) -> np.ndarray:
     """Mean fluid velocity through each cell's face on the -(dk, di) side, positive along (dk, di):
     v = (w_a + w_b)^2 / (4 mu') (p_a - p_b) / h (Poiseuille, Eq. 23); 0 where either cell is inactive."""
-    w_in = _shift(w, dk, di, 0.0)
-    p_in = _shift(p, dk, di, 0.0)
-    both = active & _shift(active, dk, di, False)
+    w_in = shift(w, dk, di, 0.0)
+    p_in = shift(p, dk, di, 0.0)
+    both = active & shift(active, dk, di, False)
     v = (np.maximum(w_in, 0) + np.maximum(w, 0)) ** 2 / (4.0 * mu_prime) * (p_in - p) / h
     return np.where(both, np.maximum(v, 0.0), 0.0)
 
 
-def _tip_cells(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndarray, reached: np.ndarray, t: float,
-               dx: float, dz: float, box_edge: bool) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+def tip_faces(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndarray, reached: np.ndarray, t: float,
+              dx: float, dz: float, box_edge: bool) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
     """For each of DIRECTIONS, the active cells whose neighbour on that side is inactive (or, with
     ``box_edge``, outside the box); and, over all of them in that order, the distance h/2 from their centre
     to that face and the tip velocity V of ``tip_velocity`` through their opposite face (one asymptote
@@ -127,7 +128,7 @@ def _tip_cells(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndarray
     masks, half, vel = [], [], []
     for dk, di in DIRECTIONS:
         h = dz if dk else dx
-        mask = active & ~_shift(active, -dk, -di, not box_edge)
+        mask = active & ~shift(active, -dk, -di, not box_edge)
         v = tip_velocity(model, inflow_velocity(active, w, p, h, dk, di, model.mu_prime), h, t, reached)
         masks.append(mask)
         half.append(np.full(int(mask.sum()), 0.5 * h))
@@ -135,8 +136,9 @@ def _tip_cells(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndarray
     return masks, np.concatenate(half), np.concatenate(vel)
 
 
-def _per_direction(values: np.ndarray, masks: list[np.ndarray]) -> list[np.ndarray]:
-    """Split values gathered over ``masks`` (in order) back into one array per mask."""
+def split_by_direction(values: np.ndarray, masks: list[np.ndarray]) -> list[np.ndarray]:
+    """Split values gathered over ``masks`` (in order, as ``tip_faces`` gathers them) back into one array per
+    mask, so that one asymptote evaluation serves the four directions."""
     return np.split(values, np.cumsum([int(m.sum()) for m in masks])[:-1])
 
 
@@ -148,18 +150,18 @@ def cells_to_open(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndar
     fastest over the triggering parents (NaN where nothing opens). ``reached`` holds the times the front
     reached each cell; ``k_prime`` and ``c_prime`` are K' and C' at every cell.
     """
-    masks, half, vel = _tip_cells(model, active, w, p, reached, t, dx, dz, box_edge=False)
+    masks, half, vel = tip_faces(model, active, w, p, reached, t, dx, dz, box_edge=False)
     w_tip = tip_width(model, np.concatenate([k_prime[m] for m in masks]),
                       np.concatenate([c_prime[m] for m in masks]), half, vel)
     to_open = np.zeros_like(active)
     speed = np.full(active.shape, np.nan)
-    for (dk, di), tips, w_dir in zip(DIRECTIONS, masks, _per_direction(w_tip, masks)):
+    for (dk, di), tips, w_dir in zip(DIRECTIONS, masks, split_by_direction(w_tip, masks)):
         h = dz if dk else dx
         ok = np.zeros_like(active)
         ok[tips] = w[tips] >= w_dir
         # candidate = the cell on the (dk, di) side of a triggering tip element
-        cand = _shift(ok, dk, di, False) & ~active
-        parent_time = _shift(reached, dk, di, np.nan)
+        cand = shift(ok, dk, di, False) & ~active
+        parent_time = shift(reached, dk, di, np.nan)
         vt = h / np.maximum(t - parent_time, 1e-300)
         speed = np.where(cand, np.fmax(speed, vt), speed)
         to_open |= cand
@@ -170,7 +172,7 @@ def edge_cells(active: np.ndarray) -> np.ndarray:
     """Active cells with at least one inactive 4-neighbour."""
     edge = np.zeros_like(active)
     for dk, di in DIRECTIONS:
-        edge |= active & ~_shift(active, dk, di, False)
+        edge |= active & ~shift(active, dk, di, False)
     return edge
 
 
@@ -180,11 +182,11 @@ def front_distances(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.nd
     """Sub-grid front position: for each of DIRECTIONS, the distance s from every active cell's centre to the
     front on that side (the inverse of ``tip_width`` at the cell's width, Eq. 33) where the neighbour on that
     side is inactive, NaN elsewhere. V is the tip velocity of ``tip_velocity`` through the opposite face."""
-    masks, _, vel = _tip_cells(model, active, w, p, reached, t, dx, dz, box_edge=True)
+    masks, _, vel = tip_faces(model, active, w, p, reached, t, dx, dz, box_edge=True)
     s_all = invert_tip(model, np.concatenate([k_prime[m] for m in masks]),
                        np.concatenate([c_prime[m] for m in masks]), np.concatenate([w[m] for m in masks]), vel)
     out = []
-    for facing, s_dir in zip(masks, _per_direction(s_all, masks)):
+    for facing, s_dir in zip(masks, split_by_direction(s_all, masks)):
         s = np.full(w.shape, np.nan)
         s[facing] = s_dir
         out.append(s)

@@ -22,8 +22,7 @@ How each front gives f (``filled_fraction``):
   sides (tip_cells.wetted_fraction: f = 1/2 + s / h on a side of a straight front, the diagonal cut in a
   corner); f = 1 in cells with no closed neighbour. A fully open rectangle (s >= one cell at its edges)
   gives exactly its own area. The same inverted distances give the front summary's radius, so the area and
-  the front agree (radial_long, universal tip: R from the area -0.5 %, from the front -0.2 % at 1e5 s;
-  ``python bench/bench_fracture.py --cases long``).
+  the front agree (``python bench/bench_fracture.py --cases long`` prints both radii's errors).
 
 Cells that contact holds shut (width 0 after their opening, newton.py) hold no fluid and count 0 in either
 mode: a barrier row that the front opened and the stress closed again is not fracture area.

@@ -13,8 +13,8 @@ g the positivity ramp of :mod:`leakoff` (times the wetted fraction, see Pinned c
 Each Newton update solves J dw = -F, either directly (dense LU, scipy.linalg.lu_factor) or, for large N,
 matrix-free by GMRES (``krylov.gmres_solve``) with C applied by FFT and a SuperLU preconditioner M of J with
 C cut to its near field of radius NEAR_FIELD_RADIUS, the cell and its 8 neighbours: a sparser factorisation
-for more GMRES iterations, at 5000 cells 0.04-0.09 s a Newton iteration against 0.05-0.31 s at radius 2
-(bench/bench_solver.py --near-field-radius 2). The update is damped by Deuflhard's natural monotonicity test
+for more GMRES iterations, cheaper per Newton iteration than a wider near field (bench/bench_solver.py
+--near-field-radius compares them). The update is damped by Deuflhard's natural monotonicity test
 (Deuflhard 2004, "Newton Methods for Nonlinear Problems", section 3.3, NLEQ-ERR): the step fraction lambda is
 halved (at most MONOTONICITY_HALVINGS times) until the simplified Newton correction shrinks,
 ||J^-1 F(w + lambda dw)|| <= (1 - lambda/4) ||J^-1 F(w)||, with the current factorisation (M for GMRES).
@@ -27,22 +27,20 @@ Jacobian reuse (``_newton``). The monotonicity test of an undamped update comput
 dw' = -J^-1 F(w + dw) with the current factorisation; when ||dw'|| <= REUSE_CONTRACTION ||dw|| the next
 iteration takes dw' as its update with the same LU (a chord step: no Jacobian, no factorisation) and, on the
 GMRES path, keeps the preconditioner M for the next solve. A chord update that fails the monotonicity test
-is not taken; the Jacobian is rebuilt at the same iterate. On the height-contained example (0-6 s) this cut
-the LU factorisations from 5.2 to 2.1 a step (same widths to 1e-7); GMRES solves to rtol
-min(1e-3, GMRES_TOLERANCE_FACTOR eps), which left the Newton iterations unchanged and halved the GMRES
-iterations against 0.1 eps. A solve may start from the preconditioner of an earlier solve on the same cells
-(``solve_step(..., preconditioner)``: the sub-grid front's solves within a step), built anew where GMRES fails
-with it: radial case IV 26 -> 18 s, the same results to the digits bench_fracture prints.
+is not taken; the Jacobian is rebuilt at the same iterate. A well-contracting iteration so costs no
+factorisation. GMRES solves to rtol min(1e-3, GMRES_TOLERANCE_FACTOR eps): Newton's convergence needs no
+tighter linear solve, and a tighter one costs GMRES iterations. A solve may start from the preconditioner of an
+earlier solve on the same cells (``solve_step(..., preconditioner)``: the sub-grid front's solves within a
+step), built anew where GMRES fails with it, so the repeated solves of one step share one factorisation.
 
 Exit on the simplified correction (``solve_step(..., simplified_exit=True)``, the sub-grid front's solves).
 The monotonicity test of an undamped update has computed dw' = -J^-1 F(w_k+1) with the current factorisation
 (M on the GMRES path), Newton's next correction to first order. When ||dw'|| < eps ||w|| Newton takes it and
 stops, the termination of Deuflhard's NLEQ-ERR, instead of spending one more iteration to find an update below
-eps. The result stays within eps of the root (tests/fracture/test_solver_choice.py). Measured: the sub-grid
-front's solves after a step's first took 2.0-2.3 Newton iterations instead of 3.0-3.2
-(radial_viscosity_subgrid.toml). The whole-cell front keeps the update test: on the field case's fracture
-(five_layer.toml) the exit took 1665 Newton iterations instead of 2106 (11.7 s instead of 14.4 s, w(0) equal
-to 1e-8), but the proppant transport that follows took 1361 steps instead of 1487 from that 1e-8.
+eps. The result stays within eps of the root (tests/fracture/test_solver_choice.py); the sub-grid front's
+repeated solves of a step each save about one iteration. The whole-cell front keeps the update test: the exit
+moves the widths within eps, and the proppant transport of a coupled run, which follows the widths, would take
+a different sequence of steps.
 
 Contact. Widths cannot go negative (the faces would interpenetrate). After Newton converges, an open cell
 with w < 0 is closed: its width is held at 0 and its unknown becomes its fluid pressure (p = sigma + c0 x,
@@ -51,7 +49,7 @@ sigma + C w - p >= 0 is the contact traction); a closed cell whose fluid pressur
 again. Newton is rerun until the set settles (at most CONTACT_PASSES passes). Every cell keeps its mass
 balance (a closing cell drains through its faces), so the volume balance stays exact.
 
-Pinned cells. The tip cells of the sub-grid front (simulator.py, tip_cells.py) enter the same way with their
+Pinned cells. The tip cells of the sub-grid front (front_subgrid.py, tip_cells.py) enter the same way with their
 prescribed width (``pinned``) in place of 0: their unknown is their fluid pressure, their width is fixed for
 the solve and their mass balance decides how much fluid flows in; ``wetted`` scales each cell's leak-off to
 the part of it behind the front.
@@ -321,8 +319,8 @@ def _volume_exact(prob: StepProblem, r: Residual, dx: np.ndarray, closed: np.nda
     """dx shifted by a uniform width at the open cells so that the update satisfies the step's volume balance
     to first order, sum_P [F + J dx]_P = 0. The lubrication terms of J have zero column sums (fluxes cancel),
     so only its diagonal A (1 + dL g') enters: an exact Newton update satisfies this, a chord update (old J)
-    or an inexact GMRES solution does not, and without the shift their converged steps lost up to 6e-8 of the
-    injected volume (radial case IV, against 1e-12)."""
+    or an inexact GMRES solution does not, and without the shift their converged steps would lose volume at the
+    level of the linear solver's tolerance instead of round-off."""
     a = np.where(closed, 0.0, prob.area * (1.0 + prob.demand * r.dg))
     total = a.sum()
     if not total > 0.0:
@@ -351,7 +349,7 @@ def start_widths(prob: StepProblem) -> np.ndarray:
     """Newton's first iterate: w_old, except that an empty cell (a cell the front just opened) starts at half
     the mean width of its open neighbours. From w = 0 the conductance derivative times the large pressure drop
     into the empty cell dominates its Jacobian row and sends the iterate to large negative widths, where
-    Newton stalled (front cells of radial cases III and IV)."""
+    Newton stalls."""
     w, a, b = prob.w_old, prob.faces.a, prob.faces.b
     total = np.bincount(a, w[b], w.size) + np.bincount(b, w[a], w.size)
     count = np.bincount(a, w[b] > 0.0, w.size) + np.bincount(b, w[a] > 0.0, w.size)

@@ -1,7 +1,7 @@
 """Which linear solver a Newton step of the fracture engine uses: the cost model of ``linear_solver = "auto"``.
 
-Per active set (simulator._Engine._rebuild) "auto" picks the dense LU (newton.py: the Jacobian gathered dense,
-scipy.linalg.lu_factor) or Newton-Krylov (GMRES with C applied by FFT over the footprint's bounding box,
+Per active set (the engine's rebuild, simulator.py) "auto" picks the dense LU (newton.py: the Jacobian gathered
+dense, scipy.linalg.lu_factor) or Newton-Krylov (GMRES with C applied by FFT over the footprint's bounding box,
 left-preconditioned by a SuperLU of the Jacobian with C cut to its near field, newton.NEAR_FIELD_RADIUS),
 whichever the model says is cheaper per Newton iteration. When the scene sets ``[fracture] krylov_threshold``
 the fixed count rule applies instead (dense below that many cells).

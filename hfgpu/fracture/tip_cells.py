@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .front import OLSON, TipModel, _per_direction, _shift, _tip_cells, invert_tip, tip_width
+from .front import OLSON, TipModel, invert_tip, shift, split_by_direction, tip_faces, tip_width
 from .tip_universal import increasing_root
 
 QUADRATURE = 8
@@ -64,9 +64,9 @@ def ribbon_distances(model: TipModel, channel: np.ndarray, w: np.ndarray, p: np.
     "asymptote" keeps the asymptote's inverse."""
     if fit not in RIBBON_FITS:
         raise ValueError(f"ribbon_distances: fit = {fit!r}; must be one of {RIBBON_FITS}")
-    masks, _, vel = _tip_cells(model, channel, w, p, reached, t, dx, dz, box_edge=False)
+    masks, _, vel = tip_faces(model, channel, w, p, reached, t, dx, dz, box_edge=False)
     v = np.full(w.shape, np.nan)
-    for mask, v_dir in zip(masks, _per_direction(vel, masks)):
+    for mask, v_dir in zip(masks, split_by_direction(vel, masks)):
         v[mask] = np.fmax(v[mask], v_dir)
     ribbon = np.isfinite(v)
     s = np.full(w.shape, np.nan)
@@ -173,8 +173,8 @@ def _eikonal_layer(d: np.ndarray, frozen: np.ndarray, dx: float, dz: float):
     flat = np.arange(d.size).reshape(d.shape)
     best = {}
     for axis, (dk, di) in (("x", (0, 1)), ("x", (0, -1)), ("z", (1, 0)), ("z", (-1, 0))):
-        near = _shift(d, dk, di, np.inf)      # d of the neighbour on the -(dk, di) side
-        src = _shift(flat, dk, di, -1)
+        near = shift(d, dk, di, np.inf)      # d of the neighbour on the -(dk, di) side
+        src = shift(flat, dk, di, -1)
         sign = float(dk + di)                 # the direction from that neighbour to the cell
         a, a_src, a_sign = best.get(axis, (np.full(d.shape, np.inf), np.full(d.shape, -1), np.zeros(d.shape)))
         take = near < a

@@ -276,7 +276,7 @@ def _age(path: Path) -> float:
 
 
 class ResultsWriter:
-    """Output sink writing an HDF5 results file (the sink methods of hfgpu/records.py).
+    """Output sink writing an HDF5 results file (an hfgpu.io.sink.ResultsSink: the records of hfgpu/records.py).
 
     The file at ``path`` is created (replaced if it exists) with the scene text and status "running".
     Use as a context manager, or call :meth:`close` with the final status. :meth:`reopen` continues a file
@@ -284,7 +284,7 @@ class ResultsWriter:
     """
 
     def __init__(self, path: str | Path, scene: Any):
-        from .. import __version__
+        from ..version import __version__
 
         acquire_lock(Path(path))
         self._start(Path(path), {"fracture": 0, "proppant": 0}, 0.0, scene)

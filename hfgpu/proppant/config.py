@@ -32,6 +32,7 @@ import numpy as np
 from ..errors import SceneError
 from ..presets import BALANCED, PRESETS, Preset
 from ..closure.config import ClassClosure, parse_class_closure
+from ..kernels.arches import ARCHES
 from ..scene_reader import Table
 from .sieve import DISTRIBUTIONS, SizeDistribution, make_distribution, sieve_range
 
@@ -40,7 +41,6 @@ PORT_KINDS = ("point", "segment", "annulus")
 #: Directions an inlet's slurry may enter along as a jet (``jet``; "none": a source without momentum).
 JET_DIRECTIONS = ("none", "+x", "-x", "+z", "-z")
 BACKENDS = ("taichi", "numpy")
-ARCHES = ("cpu", "cuda")  # Taichi architectures with float64 kernels
 
 
 @dataclass(frozen=True)

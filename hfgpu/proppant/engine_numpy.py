@@ -1,4 +1,4 @@
-"""The NumPy particle engine: the seam of hfgpu.proppant.engine over the reference operations of
+"""The NumPy particle engine: the seam of hfgpu.proppant.engine_seam over the reference operations of
 hfgpu.proppant.particle_ops_numpy. It is the oracle of the Taichi engine (the same sub-loop, arithmetic and
 parcel order up to round-off) and a run's ``[mppic] backend = "numpy"``.
 """
@@ -11,14 +11,14 @@ import numpy as np
 
 from ..errors import SimulationError
 from . import particle_ops_numpy as ref
-from .engine import SubLoop
+from .engine_seam import SubLoop
 from .grid import StaggeredGrid
 from .params import MppicParams
 from .parcels import Parcels
 
 
 class NumpyEngine:
-    """Parcels as a host :class:`Parcels`; every operation is a NumPy call (see hfgpu.proppant.engine)."""
+    """Parcels as a host :class:`Parcels`; every operation is a NumPy call (see hfgpu.proppant.engine_seam)."""
 
     name = "numpy"
     arch = "numpy"
@@ -139,13 +139,6 @@ class NumpyEngine:
             return np.zeros(parcels.n, dtype=bool)
         k, i, _ = ref.owning_cell(parcels.x, parcels.z, self.grid.frame, self.grid.shape)
         return self.outlets[k, i]
-
-    @staticmethod
-    def momentum_predictor(*args, **kwargs):
-        """The fluid's explicit momentum predictor, Eq. 26 / 49 (hfgpu.proppant.momentum)."""
-        from .momentum import momentum_predictor
-
-        return momentum_predictor(*args, **kwargs)
 
 
 def check_finite(parcels: Parcels, frame, t: float) -> None:

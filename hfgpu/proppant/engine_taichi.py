@@ -13,21 +13,18 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels import layout as L
-from .engine import SubLoop
+from .engine_seam import SubLoop
 from .engine_numpy import bad_parcel
 from .grid import StaggeredGrid
 from .params import MppicParams
-from .parcels import FLOAT_FIELDS, INT_FIELDS, Parcels
+from .parcels import Parcels
 from .particle_ops_numpy import CellMoments, check_fluid
 
-#: engine parcel rows of the Parcels fields, in Parcels order
-FLOAT_ROWS = dict(x=L.X, z=L.Z, u=L.U, v=L.V, radius=L.RADIUS, density=L.DENSITY, particles=L.PARTICLES)
-INT_ROWS = dict(state=L.STATE, class_id=L.CLASS)
 MIN_CAPACITY = 1024
 
 
 class TaichiEngine:
-    """See hfgpu.proppant.engine for the seam. Deposits (scatter, exchange): on the CPU each of up to
+    """See hfgpu.proppant.engine_seam for the seam. Deposits (scatter, exchange): on the CPU each of up to
     ``PRIVATE_COPIES`` parcel blocks sums into its own grid copy without atomics (at most ``PRIVATE_BYTES`` of
     copies in all; a block has at least ``PARCELS_PER_COPY`` parcels and at least half as many parcels as the
     grid has cells, since each copy costs a zeroing and a summing pass over the grid and each parcel about four
@@ -138,8 +135,8 @@ class TaichiEngine:
         if m == 0:
             return
         self._grow(self.n + m)
-        values = np.stack([getattr(batch, name) for name in FLOAT_FIELDS])
-        ints = np.stack([getattr(batch, name) for name in INT_FIELDS]).astype(np.int32)
+        values = np.stack([getattr(batch, name) for name in L.FLOAT_FIELDS])
+        ints = np.stack([getattr(batch, name) for name in L.INT_FIELDS]).astype(np.int32)
         self._launch(self._k.append, *self._buffers[self._current], self.n, values, ints)
         self.n += m
         if self._current == self._accepted:
@@ -158,8 +155,8 @@ class TaichiEngine:
         if self.n:
             self._launch(self._k.read_parcels, *self._buffers[self._current], values, ints)
         keep = ints[L.STATE] != L.GONE
-        return Parcels(**{name: values[row][keep] for name, row in FLOAT_ROWS.items()},
-                       **{name: ints[row][keep] for name, row in INT_ROWS.items()})
+        return Parcels(**{name: values[row][keep] for row, name in enumerate(L.FLOAT_FIELDS)},
+                       **{name: ints[row][keep] for row, name in enumerate(L.INT_FIELDS)})
 
     def set_parcels(self, parcels: Parcels) -> None:
         """Replace the parcels (accepted state)."""
@@ -203,8 +200,8 @@ class TaichiEngine:
             j = int(st[L.ST_BAD_PARCEL])
             parcel = self.parcels_at(j)
             raise bad_parcel(j, parcel[L.X], parcel[L.Z], self.grid.frame, t0 + (st[L.ST_BAD_STEP] + 1) * h)
-        (fx, bx), (fz, bz) = self.host_xf.copy(), self.host_zf.copy()
-        return SubLoop(fx, fz, bx, bz, float(st[L.ST_OUTFLOW]))
+        x, z = (dict(zip(self._k.FACE_OUT, faces.copy())) for faces in (self.host_xf, self.host_zf))
+        return SubLoop(x["force"], z["force"], x["beta"], z["beta"], float(st[L.ST_OUTFLOW]))
 
     def parcels_at(self, j: int) -> np.ndarray:
         """The float rows of parcel j (an error message's cell)."""
@@ -226,7 +223,7 @@ class TaichiEngine:
     def moments(self) -> CellMoments:
         """Cell moments of the parcels (Eq. 38), host copies."""
         self._refresh()
-        return CellMoments(*self.host_cells.copy())
+        return CellMoments(**dict(zip(self._k.CELL_OUT, self.host_cells.copy())))
 
     def max_speed(self) -> float:
         """max |u| + |v| over the parcels."""
@@ -245,13 +242,6 @@ class TaichiEngine:
                                                       self._block_sums, self._params, self._stats))
         grid += 4 * int(np.prod(self._flags.shape)) + 8 * int(np.prod(self._counts.shape))
         return per_parcel, per_parcel * self.capacity + grid
-
-    @staticmethod
-    def momentum_predictor(*args, **kwargs):
-        """The fluid's explicit momentum predictor, Eq. 26 / 49, as a Taichi kernel (hfgpu.kernels.momentum)."""
-        from ..kernels.momentum import momentum_predictor
-
-        return momentum_predictor(*args, **kwargs)
 
 
 def as_f64(a: np.ndarray) -> np.ndarray:

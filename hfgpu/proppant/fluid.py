@@ -5,12 +5,12 @@ Each step solves the continuity equation Eq. 25,
     sum over the cell's faces of the outward flux (theta_f w u)_f l_f
         + [ (theta_f w - theta_f^o w^o)/dt + s_l ] dx dz - Q = 0        (l_f = dz or dx),
 
-with the momentum predictor of Eq. 26 (:mod:`hfgpu.proppant.momentum`, NumPy or Taichi through the
-backend), by pressure correction: predictor with the guessed pressure p* -> pressure-correction equation
-(5-point, symmetric positive definite, assembled in scipy.sparse; its coefficients do not depend on p, so
-one matrix per step, solved by conjugate gradients preconditioned with the LU factors of an earlier step
-and refactorised (SuperLU) when that takes too many iterations; on CUDA, Jacobi-preconditioned CG on the GPU,
-:mod:`hfgpu.proppant.correction_warp`) -> p = p* + p', u = u* + d (p'_W - p'_E)
+with the momentum predictor of Eq. 26 (:func:`momentum_predictor`: the NumPy reference or its Taichi kernel,
+chosen by the particle backend), by pressure correction: predictor with the guessed pressure p* ->
+pressure-correction equation (5-point, symmetric positive definite, assembled in scipy.sparse; its
+coefficients do not depend on p, so one matrix per step, solved by conjugate gradients preconditioned with
+the LU factors of an earlier step and refactorised (SuperLU) when that takes too many iterations; on CUDA,
+Jacobi-preconditioned CG on the GPU, :mod:`hfgpu.proppant.correction_warp`) -> p = p* + p', u = u* + d (p'_W - p'_E)
 -> repeat until max|p'| <= tolerance x max(max|p|, pressure_floor) (the paper's 1e-5 criterion, made
 relative).
 Because the predictor couples a face only to its own pressure difference, the correction is exact and
@@ -27,6 +27,7 @@ Pressure p is dynamic (excess over the fluid hydrostatic, section 2.3.1); fluid 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -34,10 +35,11 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import splu
 
 from ..errors import SceneError, SimulationError
-from . import momentum as numpy_momentum
 from .closures import fluid_fraction, slurry_viscosity
 from .correction_warp import WarpCorrectionSolver, cuda_available
+from .engine import ENGINES
 from .grid import StaggeredGrid, face_mean
+from .momentum import momentum_predictor as numpy_predictor
 from .params import MppicParams
 
 
@@ -143,12 +145,27 @@ def courant_rate(u: np.ndarray, v: np.ndarray, dx: float, dz: float) -> float:
     return float(np.max(courant_rates(u, v, dx, dz)))
 
 
+def momentum_predictor(backend: str) -> Callable[..., tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+    """The momentum predictor (Eq. 26 / 49) of the particle backend ``backend`` (one of
+    hfgpu.proppant.engine.ENGINES): the NumPy reference :func:`hfgpu.proppant.momentum.momentum_predictor` for
+    "numpy", its Taichi kernel :func:`hfgpu.kernels.momentum.momentum_predictor` (same signature and results,
+    imported only here: it starts Taichi) for "taichi". The fluid owns its predictor; it does not borrow the
+    particle engine."""
+    if backend == "numpy":
+        return numpy_predictor
+    if backend == "taichi":
+        from ..kernels.momentum import momentum_predictor as taichi_predictor
+
+        return taichi_predictor
+    raise ValueError(f"backend: got {backend!r}; allowed: one of {list(ENGINES)}")
+
+
 class FluidSolver:
     """Modified SIMPLE (Algorithm 1) on a :class:`StaggeredGrid`.
 
-    rho_f [kg/m^3], mu_0 [Pa s]: fluid density and clean-fluid viscosity; ``backend``: any object with
-    ``momentum_predictor`` of the signature of :func:`hfgpu.proppant.momentum.momentum_predictor` (the
-    engines of :mod:`hfgpu.proppant.engine`); default the NumPy reference. ``params``
+    rho_f [kg/m^3], mu_0 [Pa s]: fluid density and clean-fluid viscosity; ``backend``: the run's particle
+    backend, "numpy" (default) or "taichi", whose momentum predictor the solver uses
+    (:func:`momentum_predictor`). ``params``
     (:class:`hfgpu.proppant.params.MppicParams`): when given, the slurry viscosity mu_f(theta_p) of Eq. 10
     (:func:`hfgpu.proppant.closures.slurry_viscosity`) is used, else mu_0 everywhere. ``wall_friction``: the
     predictor's wall-friction law, "laminar" (Eq. 9) or "dean" (MppicParams.wall_friction).
@@ -158,8 +175,9 @@ class FluidSolver:
     """
 
     def __init__(self, grid: StaggeredGrid, rho_f: float, mu_0: float,
-                 numerics: FluidNumerics = FluidNumerics(), backend=None, params: MppicParams | None = None,
-                 wall_friction: str = "laminar", linear_solver: str = "auto", arch: str = "cpu"):
+                 numerics: FluidNumerics = FluidNumerics(), backend: str = "numpy",
+                 params: MppicParams | None = None, wall_friction: str = "laminar", linear_solver: str = "auto",
+                 arch: str = "cpu"):
         for name, value in (("fluid.density", rho_f), ("fluid.viscosity", mu_0)):
             if not (np.isfinite(value) and value > 0.0):
                 raise SceneError(name, value, "must be finite and > 0")
@@ -169,7 +187,7 @@ class FluidSolver:
         self.params = params
         self.wall_friction = wall_friction
         self._linear = correction_solver(linear_solver, numerics.linear_rtol, numerics.reuse_iterations, arch)
-        self.backend = numpy_momentum if backend is None else backend
+        self.momentum_predictor = momentum_predictor(backend)
         self.set_grid(grid)
 
     @property
@@ -306,7 +324,7 @@ class FluidSolver:
         p[~active] = 0.0
         matrix = None
         for iteration in range(1, self.numerics.max_iterations + 1):
-            u, v, d_u, d_v = self.backend.momentum_predictor(
+            u, v, d_u, d_v = self.momentum_predictor(
                 state.u, state.v, p, state.width, state.theta_f, grid.width, theta_f, mu,
                 force_x, force_z, self.rho_f, dx, dz, dt, self.wall_friction)
             if drag_x is not None:  # both given (see the checks above)

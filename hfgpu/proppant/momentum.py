@@ -44,10 +44,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kernels.wall_friction import DEAN_COEFFICIENT, wall_friction_code
 from .grid import face_mean
-from .params import wall_friction_code
-
-DEAN_COEFFICIENT = 0.073  # c_f = 0.073 Re^(-1/4), Dean (1978)
 
 
 def face_coefficients(conductance: np.ndarray, mass_flux: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -5,17 +5,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import SceneError
+from ..kernels.wall_friction import WALL_FRICTION_LAWS, wall_friction_code
 
 DRAG_LAWS = ("wen-yu", "snider")
 VISCOSITY_LAWS = ("power", "krieger-dougherty")
-WALL_FRICTION_LAWS = ("laminar", "dean")
-
-
-def wall_friction_code(law: str) -> int:
-    """Integer code of a wall-friction law for kernels: 0 laminar (Eq. 9), 1 dean; ValueError for other names."""
-    if law not in WALL_FRICTION_LAWS:
-        raise ValueError(f"wall_friction {law!r} is not one of {WALL_FRICTION_LAWS}")
-    return WALL_FRICTION_LAWS.index(law)
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,7 @@
-"""Lagrangian parcels of the MP-PIC model as a structure of 1-D NumPy arrays (shared data layout)."""
+"""Lagrangian parcels of the MP-PIC model as a structure of 1-D NumPy arrays (shared data layout).
+
+The fields are those the Taichi engine keeps in its parcel rows (kernels/layout.py FLOAT_FIELDS, INT_FIELDS):
+named once there, so that a new parcel field is one edit for both."""
 
 from __future__ import annotations
 
@@ -6,32 +9,20 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ..kernels.layout import FLOAT_FIELDS, INT_FIELDS
 from ..records import GridFrame
-
-FLOAT_FIELDS = ("x", "z", "u", "v", "radius", "density", "particles")
-INT_FIELDS = ("state", "class_id")
-
-SUSPENDED = 0
-BRIDGED = 1
 
 
 @dataclass
 class Parcels:
     """Parcels: x, z [m], u, v [m/s], radius [m], density [kg/m^3], particles (real particles per parcel),
-    state (int32: 0 suspended/moving, 1 bridged), class_id (int32, index of the scene's proppant class).
+    state (int32: kernels/layout.py SUSPENDED (moving) or BRIDGED), class_id (int32, index of the scene's proppant
+    class).
 
     Arrays are contiguous float64 / int32 of equal length; operations replace or update them in place.
     """
 
-    x: np.ndarray
-    z: np.ndarray
-    u: np.ndarray
-    v: np.ndarray
-    radius: np.ndarray
-    density: np.ndarray
-    particles: np.ndarray
-    state: np.ndarray
-    class_id: np.ndarray
+    __annotations__ = {name: "np.ndarray" for name in FLOAT_FIELDS + INT_FIELDS}  # the fields, in that order
 
     def __post_init__(self) -> None:
         for name in FLOAT_FIELDS:

@@ -11,12 +11,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kernels.layout import BRIDGED, SUSPENDED
 from ..records import GridFrame
 from . import closures
 from .grid import face_mean
 from .interpolation import active_nodes, deposit, deposit_masks, interpolate, owning_cell, weights
 from .params import MppicParams
-from .parcels import BRIDGED, SUSPENDED, Parcels
+from .parcels import Parcels
 
 #: channels of the scattered per-cell sums, in order
 MOMENT_CHANNELS = ("volume", "mass", "mass_u", "mass_v", "mass_speed2", "n_r3", "n_r2")

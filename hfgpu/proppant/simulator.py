@@ -6,7 +6,7 @@ particle sub-step; a step whose Courant number comes out above C_max is undone, 
 1. the parcels entering during the step are added (:mod:`hfgpu.proppant.injection`);
 2. particle sub-loop (section 4.3), ``particle_substeps`` times dt/n in the fluid of the step's start:
    scatter (Eq. 38) -> gather (Eq. 40-41) -> push (Eq. 43-44) -> exchange (Eq. 39); parcels in outlet cells
-   are removed and their solid volume counted. The particle engine (:mod:`hfgpu.proppant.engine`: Taichi
+   are removed and their solid volume counted. The particle engine (:mod:`hfgpu.proppant.engine_seam`: Taichi
    kernels, or the NumPy oracle) owns the parcels and runs the whole sub-loop per call;
 3. scatter: theta_p at the step's end, so that the fluid's storage term (theta_f w - theta_f^o w^o)/dt of
    Eq. 25 is the change over this very step;
@@ -56,9 +56,11 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..io.progress import limit as show_limit, note
+from ..io.sink import ProppantSink
 from ..records import GridFrame, ProppantSnapshot, SolidBalanceRecord
 from .config import Geometry, Port, ProppantSetup
 from .engine import make_engine
+from .engine_seam import ParticleEngine
 from .fluid import CourantLimitExceeded, FluidNumerics, FluidSolver, FluidState, courant_rates
 from .health import KEYS, Watch
 from .grid import StaggeredGrid
@@ -163,8 +165,9 @@ class ProppantSimulation:
         for k, i in ports_to_cells(setup.geometry.outlets, self.grid.frame, self.grid.width,
                                    "geometry.outlets"):
             self.outlets[k, i] = True
-        self.engine = make_engine(self.numerics.backend, self.grid, self.params, self.rho_f, self.mu_f,
-                                  self.numerics.gravity, self.outlets, arch=self.numerics.arch)
+        self.engine: ParticleEngine = make_engine(self.numerics.backend, self.grid, self.params, self.rho_f,
+                                                  self.mu_f, self.numerics.gravity, self.outlets,
+                                                  arch=self.numerics.arch)
         self.time = 0.0
         self.rng = np.random.default_rng(scene.run.seed)
         open_volume = self.grid.cell_volume[self.grid.active]
@@ -181,7 +184,7 @@ class ProppantSimulation:
         self.solver = FluidSolver(self.grid, self.rho_f, self.mu_f,
                                   FluidNumerics(c_max=n.c_max, tolerance=n.simple_tolerance,
                                                 max_iterations=n.simple_max_iterations),
-                                  self.engine,
+                                  backend=self.numerics.backend,
                                   params=self.params if n.slurry_viscosity else None,
                                   wall_friction=self.params.wall_friction, arch=self.engine.arch)
         self.fluid = self.solver.initial_state(self._fluid_theta_p())
@@ -371,7 +374,7 @@ class ProppantSimulation:
                                   in_domain=self.engine.solid_volume(), outflow=self.outflow,
                                   screened_out=self.screened_out)
 
-    def run(self, sink, progress: Callable[[float], None] | None = None,
+    def run(self, sink: ProppantSink, progress: Callable[[float], None] | None = None,
             on_step: Callable[[StepInfo], None] | None = None, checkpoint=None, resume: dict | None = None) -> dict:
         """Step to the scene's end time, writing snapshots every ``output.every`` (and at 0 and the end) and
         a balance record every step; returns a summary.
@@ -475,7 +478,7 @@ def warn_screen_out(summary: dict, theta_cp: float, offset: float = 0.0) -> None
                       f"theta_cp = {theta_cp:g} or narrower than the largest grain", RuntimeWarning, stacklevel=3)
 
 
-def simulate(scene, sink, progress: Callable[[float], None] | None = None,
+def simulate(scene, sink: ProppantSink, progress: Callable[[float], None] | None = None,
              width_field: WidthField | None = None, checkpoint=None, resume: dict | None = None) -> dict:
     """Run the MP-PIC proppant model of ``scene`` (physics "proppant") to its end time.
 

@@ -87,17 +87,17 @@ def test_sub_grid_front_carried_across_the_2x_remeshing(monkeypatch):
     after it the wetted area and the fluid volume are those of the fine grid to round-off (the front crosses
     coarse tip cells instead of jumping out to whole cells), the balance holds at every step, and the radius
     from the area stays within 2 % of the M vertex at every step (measured 1.6 %, at the start)."""
-    from hfgpu.fracture import simulator
+    from hfgpu.fracture import simulator, views
 
     sc = load_scene((SCENES / "radial_viscosity_subgrid.toml").read_text().replace('"1e5 s"', '"2 s"'))
     carried = []
     merge = simulator._Engine.coarsen_if_wide
 
     def checked(eng):
-        before, volume = eng.geometry(eng.now())["area"], eng.balance().stored
+        before, volume = views.geometry(eng, eng.now())["area"], eng.balance().stored
         merge(eng)
         if eng.coarsenings > len(carried):
-            carried.append((before, eng.geometry(eng.now())["area"], volume, eng.balance().stored))
+            carried.append((before, views.geometry(eng, eng.now())["area"], volume, eng.balance().stored))
 
     monkeypatch.setattr(simulator._Engine, "coarsen_if_wide", checked)
     sink = MemorySink()

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from hfgpu.fracture.front import DIRECTIONS, _shift
+from hfgpu.fracture.front import DIRECTIONS, shift
 from hfgpu.fracture.geometry import filled_fraction, footprint
 from hfgpu.fracture.simulator import simulate
 from hfgpu.fracture.tip_cells import wetted_fraction
@@ -18,7 +18,7 @@ from .helpers import scene
 
 def _edge_distances(active: np.ndarray, s: float) -> list[np.ndarray]:
     """front.front_distances' layout with the same distance s at every side that faces a closed cell."""
-    return [np.where(active & ~_shift(active, -dk, -di, False), s, np.nan) for dk, di in DIRECTIONS]
+    return [np.where(active & ~shift(active, -dk, -di, False), s, np.nan) for dk, di in DIRECTIONS]
 
 
 @pytest.mark.parametrize("mode", ["cells", "subgrid"])

@@ -135,15 +135,15 @@ def test_a_step_that_cannot_shrink_enough_stops_the_run_with_a_message(monkeypat
     """A sub-grid front that moves more than max_front_advance cells however short the step (forced here:
     every step reports twice the limit) halves its steps until they fall below MIN_STEP_FRACTION of the time:
     a SimulationError naming the knob, not a division by zero."""
-    from hfgpu.fracture import simulator
+    from hfgpu.fracture.front_subgrid import SubgridFront
 
-    iterate = simulator._Engine._front_iterations
+    iterate = SubgridFront.front_iterations
 
-    def too_far(eng, dt, start):
-        res, _, converged = iterate(eng, dt, start)
+    def too_far(front, eng, dt, start):
+        res, _, converged = iterate(front, eng, dt, start)
         return res, 2.0 * eng.num.max_front_advance * min(eng.dx, eng.dz), converged
 
-    monkeypatch.setattr(simulator._Engine, "_front_iterations", too_far)
+    monkeypatch.setattr(SubgridFront, "front_iterations", too_far)
     with pytest.raises(SimulationError, match="max_front_advance") as info:
         simulate(scene(**FAST, fracture='[fracture]\nfront_tracking = "subgrid"'), MemorySink())
     assert info.value.time is not None

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from hfgpu.proppant.engine import SubLoop, make_engine
+from hfgpu.proppant.engine import make_engine
+from hfgpu.proppant.engine_seam import SubLoop
 from hfgpu.proppant.grid import StaggeredGrid
 from hfgpu.proppant.params import MppicParams
 from hfgpu.proppant.parcels import FLOAT_FIELDS, INT_FIELDS, Parcels

@@ -3,8 +3,7 @@
 import numpy as np
 import pytest
 
-from hfgpu.proppant.engine_numpy import NumpyEngine
-from hfgpu.proppant.engine_taichi import TaichiEngine
+from hfgpu.proppant.fluid import momentum_predictor
 from hfgpu.proppant.momentum import momentum_predictor as reference
 
 
@@ -33,7 +32,7 @@ def test_kernel_matches_numpy(nz, nx, closed, wall_friction):
         fields["wall_friction"] = "dean"
     # cell Peclet numbers span both branches of the power law (|P| < 10 and A = 0 beyond)
     expected = reference(**fields)
-    got = TaichiEngine.momentum_predictor(**fields)
+    got = momentum_predictor("taichi")(**fields)
     for name, e, g in zip(("u*", "v*", "d_u", "d_v"), expected, got):
         assert g.shape == e.shape, name
         scale = np.max(np.abs(e)) + 1e-300
@@ -47,5 +46,5 @@ def test_kernel_matches_numpy(nz, nx, closed, wall_friction):
 def test_numpy_backend_is_reference():
     rng = np.random.default_rng(3)
     fields = random_fields(rng, 5, 6, 0.2)
-    for e, g in zip(reference(**fields), NumpyEngine.momentum_predictor(**fields)):
+    for e, g in zip(reference(**fields), momentum_predictor("numpy")(**fields)):
         np.testing.assert_array_equal(g, e)

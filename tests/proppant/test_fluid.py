@@ -9,8 +9,6 @@ import numpy as np
 import pytest
 
 from hfgpu.errors import SceneError
-from hfgpu.proppant.engine_numpy import NumpyEngine
-from hfgpu.proppant.engine_taichi import TaichiEngine
 from hfgpu.proppant.fluid import CourantLimitExceeded, FluidNumerics, FluidSolver
 from hfgpu.proppant.grid import StaggeredGrid
 from hfgpu.proppant.params import MppicParams
@@ -266,7 +264,7 @@ def test_closed_box_body_force_stays_at_rest(backend):
     width = rng.uniform(0.5e-3, 4e-3, (nz, nx))
     width[3, 4] = 0.0  # an island
     grid = StaggeredGrid.from_width(frame, width)
-    solver = FluidSolver(grid, RHO, MU, backend={"numpy": NumpyEngine, "taichi": TaichiEngine}[backend], params=MppicParams())
+    solver = FluidSolver(grid, RHO, MU, backend=backend, params=MppicParams())
     theta_p = np.where(grid.active, rng.uniform(0.0, 0.4, (nz, nx)), 0.0)
     state = solver.initial_state(theta_p)
     fx, fz = 300.0, -9.81 * 800.0
