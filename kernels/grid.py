@@ -1,10 +1,11 @@
 """The grid passes of an MP-PIC sub-step as Taichi functions, each one top-level loop over cells or faces
 (hfgpu.kernels.engine launches them). NumPy references: hfgpu.proppant.particle_ops_numpy (finish_moments,
-grid_fields, per_face_volume), hfgpu.proppant.closures (particle_stress, damping_rate),
+grid_fields, per_face_volume), hfgpu.kernels.closures (particle_stress, damping: reference and twin),
 hfgpu.proppant.interpolation (active_nodes, face_widths) and hfgpu.proppant.simulator (pressure_reaction).
 Layout: hfgpu.kernels.layout.
 """
 
+from hfgpu.kernels.closures import damping, particle_stress
 from hfgpu.kernels.layout import (
     CELL, DAMPING, DEPOSIT_BETA, DEPOSIT_FORCE, F_BETA, F_DP, F_DTAU, F_FORCE, F_MASK, F_VELOCITY, F_WIDTH,
     M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME, MEAN_U, MEAN_V, MOMENT_COUNT, OUTLET,
@@ -12,8 +13,6 @@ from hfgpu.kernels.layout import (
     P_STRESS_P, P_THETA_CP, PRESSURE, SAUTER, TAU, THETA, VARIANCE, WIDTH)
 from hfgpu.kernels.runtime import ti
 from hfgpu.kernels.stencil import cell_flags, free_grains
-
-SQRT_3PI = 3.0699801238394655  # sqrt(3 pi)
 
 
 @ti.func
@@ -102,17 +101,11 @@ def zero_copies(D: ti.template(), copies: ti.i32, channels: ti.template()):
 
 
 @ti.func
-def stress_denominator(theta: ti.f64, PR: ti.template()) -> ti.f64:
-    """max(theta_cp - theta_p, eps (1 - theta_p)) of Eq. 16."""
-    return ti.max(PR[P_THETA_CP] - theta, PR[P_EPSILON] * (1.0 - theta))
-
-
-@ti.func
 def finish_cells(C: ti.template(), CD: ti.template(), copies: ti.i32, PR: ti.template()):
     """Per cell: the moment sums over the deposit copies, theta_p = volume / (dx dz w) (Eq. 38), mass-averaged
     velocity, velocity variance, Sauter radius (particle_ops_numpy.finish_moments), the particle stress tau of
-    Eq. 16 (closures.particle_stress) and the collision damping rate (closures.damping_rate, O'Rourke & Snider
-    2010 eq. 48), 0 in closed cells."""
+    Eq. 16 (closures.particle_stress) and the collision damping rate (closures.damping, O'Rourke & Snider 2010
+    eq. 48), 0 in closed cells."""
     for k, i in ti.ndrange((0, C.shape[1]), (0, C.shape[2])):
         sums = ti.Vector.zero(ti.f64, MOMENT_COUNT)
         for c in range(copies):
@@ -130,17 +123,10 @@ def finish_cells(C: ti.template(), CD: ti.template(), copies: ti.i32, PR: ti.tem
         C[MEAN_V, k, i] = mean_v
         C[VARIANCE, k, i] = variance
         C[SAUTER, k, i] = sauter
-        den = stress_denominator(theta, PR)
-        tau = 0.0
-        if theta > 0.0:  # theta^beta is 0 at theta = 0 (beta > 0): an empty cell skips the power
-            tau = PR[P_STRESS_P] * ti.pow(theta, PR[P_STRESS_BETA]) / den
-        C[TAU, k, i] = tau
-        rate = 0.0
-        if PR[P_DAMPING] > 0.0 and theta > PR[P_DAMPING_THRESHOLD] * PR[P_THETA_CP] and sauter > 0.0:
-            eta = 0.5 * (1.0 + PR[P_RESTITUTION])
-            g0 = ti.max(1.0, PR[P_THETA_CP] / den)
-            sigma = ti.sqrt(ti.max(variance, 0.0))
-            rate = 16.0 / SQRT_3PI * theta * sigma / sauter * g0 * eta * (1.0 - eta)
+        C[TAU, k, i] = particle_stress.particle_stress(theta, PR[P_STRESS_P], PR[P_STRESS_BETA], PR[P_THETA_CP],
+                                                       PR[P_EPSILON])
+        rate = damping.damping_rate(theta, variance, sauter, PR[P_DAMPING], PR[P_RESTITUTION],
+                                    PR[P_DAMPING_THRESHOLD], PR[P_THETA_CP], PR[P_EPSILON])
         C[DAMPING, k, i] = rate * C[CELL, k, i]
 
 

@@ -8,9 +8,8 @@ Gather: one task per LANES (16) consecutive parcels, their cell coordinates as v
 Push: one task per LANES consecutive parcels; their drag solves (Eq. 43) run as LANES-wide vectors so that the
 independent dependency chains of the parcels interleave (one parcel's fixed-point iteration is a serial chain
 of sqrt, log, exp and a division); then bed friction, bridging and the move (Eq. 44, walls) parcel by parcel.
-The powers theta_f^-2.65, theta_f^-1.78 and Re^0.687, Re^(2/3) are exp(a log b) with the inline exp and log of
-``elementary`` on LANES-wide vectors (no libm call, so LLVM vectorises them across the lanes), log theta_f
-shared.
+The drag and the packing limiter are the closures' Taichi twins (hfgpu.kernels.closures.drag, particle_stress),
+evaluated on LANES-wide vectors.
 
 Fast paths (per-cell bits of stencil.cell_flags): a parcel whose cell and its 8 neighbours are open and inside
 the grid (INTERIOR) uses plain bilinear weights without mask reads in the gather (scatter and exchange weight
@@ -27,7 +26,7 @@ results are deterministic, and random parcel order costs little more than sorted
 varies from run to run); the engine keeps the parcels sorted by cell, so runs are long and atomics few.
 """
 
-from hfgpu.kernels import elementary
+from hfgpu.kernels.closures import drag, particle_stress
 from hfgpu.kernels.layout import (
     PARAM_COUNT,
     BRIDGED, CELL, DAMPING, DENSITY, DRAG, F_DP, F_DTAU, F_MASK, F_VELOCITY, GONE, LAG_X, LAG_Z, MEAN_U,
@@ -186,20 +185,6 @@ def gather_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i32,
 
 
 @ti.func
-def power(base, exponent):
-    """base^exponent for base >= 0 (elementwise) as exp(exponent log base), 0 at base 0."""
-    positive = base > 0.0
-    return ti.select(positive, elementary.exp(exponent * elementary.log(ti.select(positive, base, 1.0))), 0.0)
-
-
-@ti.func
-def limited(delta, slip, grad, restitution: ti.f64):
-    """Snider (2001) eqs. 39-41 packing limiter of the stress velocity (particle_ops_numpy), elementwise."""
-    bound = (1.0 + restitution) * slip
-    return ti.select(grad <= 0.0, ti.max(ti.min(delta, bound), 0.0), ti.min(ti.max(delta, bound), 0.0))
-
-
-@ti.func
 def on_bed(sx: ti.f64, sz: ti.f64, radius: ti.f64, dz: ti.f64, C: ti.template(), dense: ti.f64) -> ti.f64:
     """1.0 where the cell containing (sx, sz) or the cell below it (+z) has theta_p >= dense, or the cell below
     is closed or outside the grid and the parcel is within 2 radius of that wall, else 0.0
@@ -251,8 +236,8 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, P: ti.template(), s: ti.template(), dt
     law; what does not change between iterations (stokes x theta_f^-2.65, Snider's stokes x theta_f^-1.78 / 6
     and 1 + dt / (2 tau_D)) is computed once, dt D_p once per iteration.
 
-    D_p = 4.5 mu / (rho_p r^2) x C_d Re / 24 (Eq. 13-15, closures.drag_rate): law 0 Eq. 14 (theta_f^-2.65
-    (1 + c Re^0.687) below Re = 1000, else 0.44 Re / 24 theta_f^-2.65), law 1 Snider (2001)."""
+    D_p: closures.drag (Eq. 13-15, hindered_stokes once, drag_rate per iteration); the stress velocity:
+    closures.particle_stress.packing_limiter (Snider 2001 eqs. 39-41)."""
     rho_f = PR[P_RHO_F]
     mu = PR[P_MU]
     law = ti.cast(PR[P_DRAG_LAW], ti.i32)
@@ -271,29 +256,20 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, P: ti.template(), s: ti.template(), dt
     half_rate = 0.5 * row(s, S_DAMPING)
     inv_rho = 1.0 / rho_p
     buoyant_g = (1.0 - rho_f * inv_rho) * PR[P_GRAVITY]
-    log_tf = elementary.log(1.0 - ti.min(theta, PR[P_THETA_CP]))  # theta_f of closures.fluid_fraction
-    stokes = 4.5 * mu * inv_rho / (r * r)
-    stokes_hinder = stokes * elementary.exp(-2.65 * log_tf)
-    snider = stokes * 0.0
-    if law == 1:
-        snider = stokes * elementary.exp(-1.78 * log_tf) * (1.0 / 6.0)
-    exponent = 2.0 / 3.0 if law == 1 else 0.687
+    stokes_hinder, snider = drag.hindered_stokes(drag.STOKES_FACTOR * mu * inv_rho / (r * r), theta,
+                                                 PR[P_THETA_CP], law)
     re_per_slip = (2.0 * rho_f / mu) * r
     force_u = u0 + dt * (half_rate * mean_u - dpdx * inv_rho)
     force_v = v0 + dt * (half_rate * mean_v + buoyant_g - dpdz * inv_rho)
     den_rest = 1.0 + dt * half_rate
     un = u0
     vn = v0
-    drag = u0 * 0.0
-    inv_den = drag + 1.0
+    rate = u0 * 0.0
+    inv_den = rate + 1.0
     for _ in range(ti.cast(PR[P_DRAG_ITERATIONS], ti.i32)):
         re = re_per_slip * ti.sqrt((uf - un) ** 2 + (vf - vn) ** 2)
-        re_power = power(re, exponent)
-        if law == 1:
-            drag = stokes_hinder + snider * re_power
-        else:
-            drag = stokes_hinder * ti.select(re < 1000.0, 1.0 + re_coefficient * re_power, (0.44 / 24.0) * re)
-        dt_drag = dt * drag
+        rate = drag.drag_rate(re, stokes_hinder, snider, law, re_coefficient)
+        dt_drag = dt * rate
         inv_den = 1.0 / (den_rest + dt_drag)
         un = (force_u + dt_drag * uf) * inv_den
         vn = (force_v + dt_drag * vf) * inv_den
@@ -301,9 +277,9 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, P: ti.template(), s: ti.template(), dt
     gx = row(s, S_DTDX)
     gz = row(s, S_DTDZ)
     restitution = PR[P_PACKING_RESTITUTION]
-    un = un + limited(scale * gx, mean_u - un, gx, restitution)
-    vn = vn + limited(scale * gz, mean_v - vn, gz, restitution)
-    return un, vn, drag
+    un = un + particle_stress.packing_limiter(scale * gx, mean_u - un, gx, restitution)
+    vn = vn + particle_stress.packing_limiter(scale * gz, mean_v - vn, gz, restitution)
+    return un, vn, rate
 
 
 @ti.func
@@ -377,12 +353,12 @@ def push_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i32, C
         pr = constants(PR)
         s = ti.Matrix([[W[j, ti.min(p0 + l, n - 1)] for l in ti.static(range(LANES))]
                        for j in ti.static(range(SEEN))], dt=ti.f64)
-        un, vn, drag = velocity_lanes(p0, n, P, s, dt, pr)
+        un, vn, rates = velocity_lanes(p0, n, P, s, dt, pr)
         for l in ti.static(range(LANES)):  # GONE parcels too: nothing reads them before the next sort drops them
             if p0 + l < n:
                 P[U, p0 + l] = un[l]
                 P[V, p0 + l] = vn[l]
-                W[DRAG, p0 + l] = drag[l]
+                W[DRAG, p0 + l] = rates[l]
         for l in range(ti.cast(ti.min(LANES, n - p0), ti.i32)):
             if S[STATE, p0 + l] != GONE:
                 push_parcel(p0 + l, P, S, W, C, FLAGS, dt, pr)

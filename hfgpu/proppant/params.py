@@ -1,13 +1,13 @@
-"""Closure parameters of the MP-PIC particle phase (the paper, Eq. 10-16, 43; REFERENCE.md section 6)."""
+"""Closure parameters of the MP-PIC particle phase (the paper, Eq. 10-16, 43)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 from ..errors import SceneError
+from ..kernels.closures.drag import DRAG_LAWS
 from ..kernels.wall_friction import WALL_FRICTION_LAWS, wall_friction_code
 
-DRAG_LAWS = ("wen-yu", "snider")
 VISCOSITY_LAWS = ("power", "krieger-dougherty")
 
 

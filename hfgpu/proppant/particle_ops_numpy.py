@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kernels.closures.particle_stress import packing_limiter_numpy
 from ..kernels.layout import BRIDGED, SUSPENDED
 from ..records import GridFrame
 from . import closures
@@ -188,14 +189,6 @@ def gather(parcels: Parcels, frame: GridFrame, fields: GridFields) -> ParcelFlui
         width=np.where(inside, fields.width[ko, io], 0.0))
 
 
-def _limited_stress_velocity(delta, slip, grad, restitution):
-    """Snider (2001) eqs. 39-41 as in MFIX integrate_time_pic.f90: the stress velocity correction delta is
-    limited by (1 + e) x (mean parcel velocity - parcel velocity) and may only act along -grad tau."""
-    bound = (1.0 + restitution) * slip
-    return np.where(grad <= 0.0, np.maximum(np.minimum(delta, bound), 0.0),
-                    np.minimum(np.maximum(delta, bound), 0.0))
-
-
 def on_bed(x, z, radius, frame: GridFrame, width: np.ndarray, volume_fraction: np.ndarray,
            params: MppicParams) -> np.ndarray:
     """True where the parcel rests in or on a dense bed: its own cell or the cell below it (+z, the direction
@@ -291,7 +284,8 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     Velocity: u~ = (u^o + dt (D u_f - grad p / rho_p + (1 - rho_f/rho_p) g + <u>/(2 tau_D))) /
     (1 + dt (D + 1/(2 tau_D))), drag D(|u_f - u|) iterated ``drag_iterations`` times starting from u^o (the
     returned D is the one of the last solve). Then the stress term -dt grad tau / (theta_p rho_p (1 + ...)),
-    limited per component by Snider (2001) eqs. 39-41 (packing limiter, see _limited_stress_velocity).
+    limited per component by Snider (2001) eqs. 39-41 (packing limiter,
+    hfgpu.kernels.closures.particle_stress).
     Walls, per component (x first): a move that would leave the grid, enter a closed cell, enter another cell
     narrower than the parcel's bridging width (bridging_factor x 2 r), or raise the
     parcel's bilinear weight on a cell whose theta_p (this step's scatter) is already >= theta_cp, or approach a
@@ -319,10 +313,10 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
         v_new = (parcels.v + dt * (drag * seen.fluid_v - seen.dpdz / rho_p + buoyant_g
                                    + half_rate * seen.mean_v)) / den
     scale = -dt / (np.maximum(theta, params.epsilon) * rho_p * den)
-    u_new = u_new + _limited_stress_velocity(scale * seen.dtaudx, seen.mean_u - u_new, seen.dtaudx,
-                                             params.packing_restitution)
-    v_new = v_new + _limited_stress_velocity(scale * seen.dtaudz, seen.mean_v - v_new, seen.dtaudz,
-                                             params.packing_restitution)
+    u_new = u_new + packing_limiter_numpy(scale * seen.dtaudx, seen.mean_u - u_new, seen.dtaudx,
+                                          params.packing_restitution)
+    v_new = v_new + packing_limiter_numpy(scale * seen.dtaudz, seen.mean_v - v_new, seen.dtaudz,
+                                          params.packing_restitution)
     resting = on_bed(parcels.x, parcels.z, parcels.radius, frame, fields.width, fields.volume_fraction, params)
     u_new = _bed_friction(u_new, resting, buoyant_g, dt, den, params)
     u_new = np.where(_deposited(parcels.x, parcels.z, resting, seen, parcels.radius, rho_p, frame, fields, params,
