@@ -213,7 +213,8 @@ def test_grains_in_a_contact_network_leave_the_pressure_gradient_to_the_skeleton
     left, right = theta[:, :-1], theta[:, 1:]
     both_free = (left < fraction) & (right < fraction) & (fields.xface_mask[:, 1:-1] > 0)
     both_network = (left >= fraction) & (right >= fraction)
-    load = 0.5 * (left * w[:, :-1] + right * w[:, 1:]) / (0.5 * (w[:, :-1] + w[:, 1:]))
+    w_f = 0.5 * (w[:, :-1] + w[:, 1:])
+    load = np.divide(0.5 * (left * w[:, :-1] + right * w[:, 1:]), w_f, out=np.zeros_like(w_f), where=w_f > 0)
     close(rx[:, 1:-1][both_free], -(load * fields.dpdx[:, 1:-1])[both_free])
     np.testing.assert_array_equal(rx[:, 1:-1][both_network], 0.0)
     assert both_free.sum() > 10 and both_network.sum() > 10
