@@ -21,6 +21,7 @@ import numpy as np
 import hfgpu
 from hfgpu.io.plots import plot_results
 from hfgpu.io.results import open_results
+from hfgpu.units import format_number
 
 DEFAULT_SCENE = "slickwater_demo.toml"
 #: A cell is counted as bed when its solid volume fraction is at least this share of close packing.
@@ -52,7 +53,7 @@ def story(results_path: Path) -> dict:
 def print_story(s: dict) -> None:
     print(f"proppant at t = {s['time']:.0f} s, by class and where it lies")
     for name, n in s["parcels"].items():
-        print(f"  {name:<32}  {n} parcels, {s['mass'][name] * KG_TO_LB:,.0f} lb")
+        print(f"  {name:<32}  {format_number(n)} parcels, {format_number(s['mass'][name] * KG_TO_LB)} lb")
     print(f"  {'bed cells':<32}  {s['bed_cells']} (solid fraction >= {BED_SHARE:g} x close packing)")
     print(f"  {'bridging-risk cells':<32}  {s['bridging_cells']} (width < bridging_factor x grain diameter)")
     print(f"  {'held back at the inlet':<32}  {100 * s['held_back_share']:.1f} % of the injected proppant")
