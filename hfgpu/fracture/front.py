@@ -7,7 +7,7 @@ linear-elastic (toughness) tip asymptote with Olson's (1991) correction of the c
 On its own that asymptote says "propagate" for almost any width when K' is small (viscosity-dominated
 growth), so the default ``tip_asymptote = "km"`` uses the larger of the toughness asymptote and the
 viscosity (M-vertex) asymptote of Desroches et al. (1994), w = beta_m (mu' V / E')^(1/3) s^(2/3),
-beta_m = 2^(1/3) 3^(5/6) (REFERENCE.md 1.3): a cheap envelope of the universal K-M asymptote of Dontsov &
+beta_m = 2^(1/3) 3^(5/6) (Dontsov 2016): a cheap envelope of the universal K-M asymptote of Dontsov &
 Peirce (2015), exact at both ends. Olson's 0.806 multiplies the toughness term only: it was derived for
 the s^(1/2) profile of constant-DD tip elements, not for the s^(2/3) viscous one. ``tip_asymptote =
 "universal"`` uses that universal asymptote itself (tip_universal.py), with Carter's leak-off C' = 2 C_L of

@@ -1,7 +1,7 @@
 """Carter leak-off (Eq. 29's C'/sqrt(t - tau) term), integrated exactly over a time step.
 
 The leak-off velocity through both faces of an element that opened at time tau is q_L = C'/sqrt(t - tau)
-with C' = 2 C_L (Carter 1957; the convention of PyFrac and Dontsov 2016, REFERENCE.md section 1). Over a
+with C' = 2 C_L (Carter 1957; the convention of PyFrac and Dontsov 2016). Over a
 step [t0, t1] the volume per unit area is the exact integral
 
     int_{max(t0, tau)}^{t1} C'/sqrt(t - tau) dt = 2 C' (sqrt(t1 - tau) - sqrt(max(t0, tau) - tau)).

@@ -17,10 +17,9 @@ every step.
 Start. The run starts at t0 from a radial fracture of radius R0 = ``initial_radius_cells`` cells around the
 injection cell's centre (the cells whose centres lie inside it; the grid is placed on the layer boundaries,
 mesh.fit_layers, so that centre is up to half a cell from the injection depth). t0 is the latest of the times
-at which the four radial vertex solutions (M, K, Mt, Kt; REFERENCE.md 1.1) reach R0 with the properties at the
-injection point -- the slowest mechanism controls early growth -- and the cells' opening times follow that
-vertex's R ~ t^a
-(tau = t0 (r / R0)^(1/a)). The cells hold the volume injected by t0 less the Carter volume leaked since
+at which the four radial vertex solutions (M, K, Mt, Kt: Savitski & Detournay 2002, Madyarova 2003) reach R0
+with the properties at the injection point -- the slowest mechanism controls early growth -- and the cells'
+opening times follow that vertex's R ~ t^a (tau = t0 (r / R0)^(1/a)). The cells hold the volume injected by t0 less the Carter volume leaked since
 their opening times (at most 90 % of it), in the shape a uniform net pressure gives (C w = const).
 
 Coarsening. With ``mesh.max_cells_across`` set, the grid is coarsened by ``mesh.coarsening_factor`` (coarsen.py:
@@ -91,7 +90,7 @@ def check_scene(scene) -> None:
 def initial_time(e_prime: float, mu_prime: float, k_prime: float, c_prime: float, q: float,
                  radius: float) -> tuple[float, float]:
     """(t0, a): the latest time at which a radial vertex solution reaches ``radius`` and its exponent a
-    (R ~ t^a). Vertices (REFERENCE.md 1.1): M R = 0.6955 (E' Q^3 t^4 / mu')^(1/9); K R = 0.8546
+    (R ~ t^a). Vertices (Savitski & Detournay 2002; Madyarova 2003): M R = 0.6955 (E' Q^3 t^4 / mu')^(1/9); K R = 0.8546
     (E' Q t / K')^(2/5); Mt = Kt R = 0.4502 (Q^2 t / C'^2)^(1/4). In float64 arithmetic: an absurd rate
     (Q^3 past 1e308) gives t0 = 0, not an OverflowError from Python's float power."""
     q = np.float64(q)

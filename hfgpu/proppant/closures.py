@@ -1,7 +1,7 @@
 """Vectorised MP-PIC closures with MppicParams: drag (Eq. 13-15), particle stress (Eq. 16), collision damping
 (their NumPy references and Taichi twins are in hfgpu.kernels.closures, one module per family), slurry
-viscosity (Eq. 10), the threshold of motion. Sources of the reference forms are in
-/work/shared/validation-data/REFERENCE.md section 6."""
+viscosity (Eq. 10), the threshold of motion. Sources: the paper's equations; Snider (2001); Harris & Crighton
+(1994); O'Rourke & Snider (2010)."""
 
 from __future__ import annotations
 

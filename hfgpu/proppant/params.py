@@ -19,7 +19,7 @@ class MppicParams:
     Eq. 16 (paper: 4 Pa, 2, 1e-7). restitution: e of the O'Rourke & Snider (2010) damping time.
     drag_law: "wen-yu" = the paper's Eq. 14 with ``drag_re_coefficient`` in front of Re^0.687 (the paper
     prints 0.5; Schiller-Naumann / Wen-Yu is 0.15, the default); "snider" = Snider (2001)
-    C_d = 24/Re (theta_f^-2.65 + Re^(2/3) theta_f^-1.78 / 6) (REFERENCE.md 6.2).
+    C_d = 24/Re (theta_f^-2.65 + Re^(2/3) theta_f^-1.78 / 6) (Snider 2001).
     viscosity_law: slurry viscosity for the fluid: "power" = Eq. 10 with ``viscosity_exponent`` (-1.82),
     "krieger-dougherty" = (1 - theta/theta_cp)^(-2.5 theta_cp).
     max_relative_viscosity: cap on mu_f / mu_0 of the slurry viscosity (both laws diverge at close packing).

@@ -1,8 +1,8 @@
 """Proppant sieve classes and particle-size distributions (seeded, reproducible).
 
 A mesh class "A/B" is the sand that passes sieve No. A and is retained on No. B, so its diameters lie between
-the openings of B and A. Openings are the US Standard / ASTM E11 series (REFERENCE.md section 5: Wikipedia
-"Mesh (scale)", screenerking.com ASTM E11 table; frac-sand practice per API RP 19C / ISO 13503-2).
+the openings of B and A. Openings are the US Standard series of ASTM E11 (frac-sand practice per API RP 19C /
+ISO 13503-2).
 "100 mesh" frac sand is nominally 70/140 (0.106-0.212 mm).
 """
 

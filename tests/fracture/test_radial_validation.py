@@ -1,5 +1,5 @@
 """Radial fractures of the paper's Table 2 against Dontsov's (2016) universal radial solution and the
-vertex closed forms (Savitski & Detournay 2002; REFERENCE.md 1.1, 1.3), via hfgpu.reference.radial.
+vertex closed forms (Savitski & Detournay 2002; Dontsov 2016), via hfgpu.reference.radial.
 
 Default runs are coarse (about 20-25 cells across the final diameter); tolerances reflect that. The
 refinement series and the 2 % (radius) / 5 % (inlet width) goals are marked slow. R is the front's mean

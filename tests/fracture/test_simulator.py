@@ -13,7 +13,7 @@ from hfgpu.scene import load_scene
 
 from .helpers import SCENES, scene, scene_text
 
-# M-regime-ish small case: E' 3.2e10, Q 1e-3, mu 1 Pa s -> R(100 s) ~ 6 m (REFERENCE.md 1.4)
+# M-regime-ish small case: E' 3.2e10, Q 1e-3, mu 1 Pa s -> R(100 s) ~ 6 m (the M vertex, Savitski & Detournay 2002)
 FAST = dict(end_time="100 s", cell="1 m", every="25 s")
 
 

@@ -1,5 +1,5 @@
-"""Wu et al. (2008) layered-stress experiment (REFERENCE.md section 4): simulated front extents against
-the digitised fronts (PyFrac's examples/wu_et_al_data.csv, via the shared_dir fixture)."""
+"""Wu et al. (2008) layered-stress experiment (ARMA 08-267): simulated front extents against the digitised
+fronts (PyFrac's examples/wu_et_al_data.csv, via the shared_dir fixture)."""
 
 import numpy as np
 import pytest

@@ -1,6 +1,7 @@
 """Packing limiter of the push: a suspension settling onto the floor of a slot builds a bed that does not
-over-pack and then stays at rest (REFERENCE.md 6.5; Snider 2001 eqs. 39-41 plus the push's packing cap); Coulomb
-bed friction holds grains resting on a bed or floor against a weak tangential flow and slows sliding ones."""
+over-pack and then stays at rest (Snider 2001 eqs. 39-41, as in MFIX's integrate_time_pic.f90, plus the push's
+packing cap); Coulomb bed friction holds grains resting on a bed or floor against a weak tangential flow and
+slows sliding ones."""
 
 import numpy as np
 import pytest

@@ -287,7 +287,7 @@ def test_parcel_at_rest_in_still_fluid_without_gravity_stays(backend_name):
                                                                 ("taichi", "snider", 0.0659)])
 def test_single_parcel_reaches_terminal_velocity(backend_name, drag_law, published):
     """Still fluid: the implicit push converges to D_p(v) v = (1 - rho_f/rho_p) g, the analytic fixed point;
-    at theta_p -> 0 that is the terminal velocity of REFERENCE.md 7 (d = 0.45 mm in water: Schiller-Naumann
+    at theta_p -> 0 that is the single-grain terminal velocity (weight = drag; d = 0.45 mm in water: Schiller-Naumann
     0.0669 m/s, Snider C_d 0.0659 m/s). The parcel's own theta_p (~5e-11 in its 1 m^3 cell) moves the fixed
     point by ~1e-10 relative, below the tolerance, and is taken as 0."""
     nz, nx = 4, 3

@@ -1,5 +1,5 @@
-"""Chun, Li & Wu (2020) slot test (the paper's Table 3, REFERENCE.md 5): the scene's set-up, and (slow) the
-proppant bank's length and area at 10-30 s against the experiment as digitised by GEOS
+"""Chun, Li & Wu (2020) slot test (the paper's Table 3; GEOS's proppantSlotTest set-up): the scene's set-up, and
+(slow) the proppant bank's length and area at 10-30 s against the experiment as digitised by GEOS
 (../shared/validation-data/chun_2020_bank_length_area_geos.txt).
 
 Bank: the cells whose theta_p >= half of close packing (hfgpu.proppant.analysis.bank); its length is the
@@ -26,7 +26,7 @@ def test_slot_scene_matches_the_experiment():
     assert (g.length, g.height, g.width) == pytest.approx((1.2192, 0.3048, 7.62e-3))
     q = scene.injection.schedule.rate(1.0)
     assert q == pytest.approx(6 * 3.785411784e-3 / 60)  # 6 gpm
-    # 1.5 ppg of 2550 kg/m^3 sand: slurry fraction (c/rho)/(1 + c/rho) = 0.065845 (REFERENCE.md 5)
+    # 1.5 ppg of 2550 kg/m^3 sand: slurry fraction (c/rho)/(1 + c/rho) = 0.065845
     c = 1.5 * 0.45359237 / 3.785411784e-3
     assert scene.injection.schedule.proppant_fraction(1.0)[1] == pytest.approx((c / 2550) / (1 + c / 2550), rel=1e-5)
     assert scene.proppant.classes[0].size.d_min == pytest.approx(0.3e-3)  # 30/50 mesh

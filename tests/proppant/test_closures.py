@@ -1,5 +1,5 @@
-"""MP-PIC closures against published check values (REFERENCE.md section 6, computed from Snider 2001,
-Gidaspow 1994 / MFIX, Harris & Crighton 1994, O'Rourke & Snider 2010) and closed-form limits."""
+"""MP-PIC closures against check values evaluated independently from their sources (Snider 2001, Gidaspow 1994
+as in MFIX, Harris & Crighton 1994, O'Rourke & Snider 2010) and closed-form limits."""
 
 import numpy as np
 import pytest
@@ -8,7 +8,8 @@ from hfgpu.errors import SceneError
 from hfgpu.proppant import closures
 from hfgpu.proppant.params import MppicParams
 
-# REFERENCE.md 6.2 check case: d = 0.45 mm, rho_p = 2550, rho_f = 1000, mu = 1 mPa s, |du| = 0.05 m/s
+# Check case (values evaluated independently from each source's formula): d = 0.45 mm, rho_p = 2550,
+# rho_f = 1000, mu = 1 mPa s, |du| = 0.05 m/s
 D, RHO_P, RHO_F, MU, SLIP = 0.45e-3, 2550.0, 1000.0, 1e-3, 0.05
 THETA_F = np.array([0.99, 0.90, 0.80, 0.70, 0.60])
 
@@ -18,7 +19,7 @@ def test_reynolds_of_check_case():
 
 
 def test_snider_drag_table():
-    """Snider (2001) C_d and D_p columns of REFERENCE.md 6.2 (4-5 significant digits printed)."""
+    """Snider (2001) C_d and D_p at the check case (4-5 significant digits)."""
     params = MppicParams(drag_law="snider")
     cd = closures.drag_coefficient(22.5, THETA_F, params)
     np.testing.assert_allclose(cd, [2.5379, 3.1194, 4.0346, 5.4182, 7.6472], rtol=1e-4)
@@ -28,7 +29,7 @@ def test_snider_drag_table():
 
 def test_wen_yu_factor_reproduces_gidaspow_dilute_branch():
     """Eq. 14's factor (coefficient 0.15) with Gidaspow's Reynolds number theta_f Re gives Gidaspow's
-    D_p = beta / (theta_s rho_p) for theta_f >= 0.8 (REFERENCE.md 6.2 table, MFIX convention)."""
+    D_p = beta / (theta_s rho_p) for theta_f >= 0.8 (Gidaspow 1994 in MFIX's convention, evaluated independently)."""
     params = MppicParams()
     tf = THETA_F[:3]
     dp = 4.5 * MU / (RHO_P * (D / 2) ** 2) * closures.drag_factor(tf * 22.5, tf, params)
@@ -46,7 +47,8 @@ def test_drag_stokes_limit_and_newton_branch():
 
 
 def test_harris_crighton_check_values():
-    """REFERENCE.md 6.3: P_s = 100 Pa, beta = 3, theta_cp = 0.6, eps = 1e-7."""
+    """Harris & Crighton (1994) as in OpenFOAM's HarrisCrighton model: P_s = 100 Pa, beta = 3, theta_cp = 0.6,
+    eps = 1e-7."""
     params = MppicParams(P_s=100.0, beta=3.0)
     tau = closures.particle_stress([0.1, 0.3, 0.5, 0.55, 0.59, 0.60], params)
     np.testing.assert_allclose(tau, [0.2, 9.0, 125.0, 332.75, 2053.8, 5.4e8], rtol=1e-4)
@@ -62,7 +64,7 @@ def test_stress_derivative_matches_finite_difference(theta):
 
 
 def test_damping_check_values():
-    """REFERENCE.md 6.4: theta_cp = 0.6, r32 = 0.225 mm."""
+    """O'Rourke & Snider (2010) eq. 48: theta_cp = 0.6, r32 = 0.225 mm."""
     r32 = 0.225e-3
     cases = [(0.3, 0.01, 0.9, 6.60), (0.5, 0.01, 0.9, 33.0), (0.55, 0.05, 0.85, 530.3)]
     for theta, sigma, e, expected in cases:

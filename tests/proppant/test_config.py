@@ -65,7 +65,7 @@ depth = "10 cm"
 schedule = [{ until = "10 s", rate = "6 gpm", proppant = "sand", concentration = "1.5 ppg" }]
 [[proppant]]""", 1)
     scene = load_scene(text)
-    # REFERENCE.md section 5: 1.5 ppg of 2550 kg/m^3 sand -> slurry fraction 0.065845
+    # Chun et al. (2020): 1.5 ppg of 2550 kg/m^3 sand -> slurry fraction (c/rho)/(1 + c/rho) = 0.065845
     assert scene.injection.schedule.proppant_fraction(1.0) == ("sand", pytest.approx(0.065845, abs=2e-6))
     inlet = scene.proppant.geometry.inlets[0]
     assert inlet.kind == "segment" and inlet.depth_end == pytest.approx(0.12) and inlet.jet == "none"

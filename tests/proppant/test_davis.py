@@ -1,6 +1,7 @@
 """Davis, Herbolzheimer & Acrivos (1982) bimodal batch sedimentation with the paper's parameters (section 5.2.1):
 the speeds of the two interfaces (clear | light-only suspension | mixture) against Kynch theory with the
-Masliyah / Lockett-Bassoon slip velocities (hfgpu.reference.settling.bidisperse_batch, REFERENCE.md 3).
+Masliyah / Lockett-Bassoon slip velocities (hfgpu.reference.settling.bidisperse_batch; Masliyah 1979, Lockett &
+Bassoon 1979, Kynch 1952).
 
 The upper interface is where the light class's theta_p crosses half the light-only fraction phi_L', the lower one
 where the heavy class's crosses half phi_H; speeds are least-squares slopes over the time the interface needs to
@@ -60,7 +61,7 @@ def test_davis_interface_speeds_short_column():
     text = (SCENE.replace('length = "1 cm"', 'length = "5 mm"').replace('height = "100 cm"', 'height = "20 cm"')
             .replace('cell_size = "1 cm"', 'cell_size = "5 mm"').replace("[mppic]", '[mppic]\nbackend = "numpy"'))
     theory = kynch(load_scene(text))
-    assert theory.lower_speed == pytest.approx(5.4485e-4, rel=1e-3)  # REFERENCE.md 3 table
+    assert theory.lower_speed == pytest.approx(5.4485e-4, rel=1e-3)  # MLB, n = 4.65, Davis et al.'s parameters
     assert theory.upper_speed == pytest.approx(1.9316e-4, rel=1e-3)
     upper, lower, _ = measured_speeds(text, 200.0, (0.01, 0.09))
     assert lower == pytest.approx(theory.lower_speed, rel=0.05)

@@ -3,7 +3,7 @@
 (1) one particle: terminal velocity vs Stokes (1851) at Re << 1 (2 %) and vs the drag law's own terminal velocity
     (the paper's Eq. 13-15, Schiller-Naumann constant) at Re ~ 30 (2 %);
 (2) a uniform monodisperse suspension in a closed column: the top interface falls at the Richardson-Zaki speed
-    u_t (1 - phi)^n with the exponent n implied by the drag law (REFERENCE.md 3, 7) (5 %).
+    u_t (1 - phi)^n with the exponent n implied by the drag law (Richardson & Zaki 1954) (5 %).
 The column is one cell wide (a 1-D batch test: continuity fixes the fluid's counter-flow).
 """
 
@@ -91,7 +91,7 @@ def test_hindered_settling_richardson_zaki(phi):
     rho_f, mu = scene.fluid.density, scene.fluid.viscosity
     law = drag_law(scene.proppant.params)
     n = float(settling.implied_exponent(cls.size.mean, cls.density, rho_f, mu, phi, law))
-    assert n == pytest.approx(4.65, abs=0.01)  # Stokes regime: 2.65 + 2 (REFERENCE.md 7)
+    assert n == pytest.approx(4.65, abs=0.01)  # Stokes regime: 2.65 + 2 (Richardson & Zaki's 4.65)
     ut = float(settling.terminal_velocity(cls.size.mean, cls.density, rho_f, mu, law))
     expected = float(settling.hindered_velocity(ut, phi, n))
     # fit while the interface falls from 5 mm (one cell) to 30 mm, above the rising bed

@@ -1,4 +1,4 @@
-"""Sieve classes (ASTM E11 openings, REFERENCE.md section 5) and seeded size distributions."""
+"""Sieve classes (ASTM E11 openings) and seeded size distributions."""
 
 from __future__ import annotations
 
