@@ -18,8 +18,10 @@ file read its units (``units=`` overrides them); those that take a snapshot draw
 from __future__ import annotations
 
 import math
+import re
+import textwrap
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -193,9 +195,10 @@ def footprints(results: Results, boundaries: Sequence[float] | None = None,
     layer boundaries [m] (default: the stored scene's)."""
     boundaries = layer_boundaries(results) if boundaries is None else boundaries
     u = _units(results, units)
-    fig = Figure(figsize=(6, 5), layout="constrained")
-    ax = fig.subplots()
     snaps = list(results.fracture_snapshots)
+    exaggeration = vertical_exaggeration(snaps)
+    fig = Figure(figsize=(6, 5) if exaggeration == 1 else (8, 4.5), layout="constrained")
+    ax = fig.subplots()
     colours = _viridis(len(snaps))
     for snap, colour in zip(snaps, colours):
         x, z = snap.frame.centres(*snap.width.shape)
@@ -207,10 +210,32 @@ def footprints(results: Results, boundaries: Sequence[float] | None = None,
                             for s in snaps))
         draw_layers(ax, _lengths(boundaries, u), u("length", min(lows)), u("length", max(highs)))
     ax.invert_yaxis()
-    ax.set(**_xz_labels(u), title="footprint (width > 0) over time", aspect="equal")
-    _legend(ax, Line2D([], [], color="k", lw=1, label="footprint outline (colour: time)"))
+    title = "footprint (width > 0) over time" + ("" if exaggeration == 1 else
+                                                 f", depth exaggerated {exaggeration:g}x")
+    ax.set(**_xz_labels(u), title=title, aspect=exaggeration)
+    handles, _ = ax.get_legend_handles_labels()
+    fig.legend(handles=[*handles, Line2D([], [], color="k", lw=1, label="footprint outline (colour: time)")],
+               loc="outside lower center", ncols=2, fontsize=7)
     _time_colourbar(fig, ax, results.fracture_snapshots.times)
     return fig
+
+
+#: A footprint more than this many times longer than high is drawn with its depth exaggerated.
+FOOTPRINT_ELONGATION = 4.0
+
+
+def vertical_exaggeration(snaps: Sequence[Any]) -> float:
+    """1 for a footprint no more than FOOTPRINT_ELONGATION times as long as it is high (drawn to scale), else the
+    whole-number factor (depth exaggeration) that draws it about that elongated."""
+    opened = [s for s in snaps if (s.width > 0).any()]
+    if not opened:
+        return 1.0
+    last = opened[-1]
+    rows, cols = np.nonzero(last.width > 0)
+    length = (cols.max() - cols.min() + 1) * last.frame.dx
+    height = (rows.max() - rows.min() + 1) * last.frame.dz
+    ratio = length / height
+    return 1.0 if ratio <= FOOTPRINT_ELONGATION else float(max(1, round(ratio / FOOTPRINT_ELONGATION)))
 
 
 def area_efficiency(results: Results, units: FigureUnits | None = None) -> Figure:
@@ -603,9 +628,13 @@ def status_banner(results: Results) -> str | None:
     summary = results.summary or {}
     found = summary.get("proppant_unphysical_states") or summary.get("unphysical_states") or ""
     if found:
-        kinds = [item.split(":")[0] for item in str(found).split("; ")]
+        kinds = re.findall(r"(?:^|; )([a-z][^;:]*? at t = [^:;]+ s):", str(found)) or [str(found)[:80]]
         lines.append("unphysical states: " + "; ".join(kinds))
-    return "\n".join(lines) or None
+    return "\n".join(textwrap.fill(line, BANNER_WIDTH) for line in lines) or None
+
+
+#: Characters per line of the status banner (it must fit the narrowest figure, 6 in wide at 8 pt).
+BANNER_WIDTH = 95
 
 
 def figures(results: Results, units: FigureUnits | None = None) -> dict[str, Figure]:

@@ -61,8 +61,41 @@ def test_layered_maps_draw_the_boundaries(layered):
     for ax in maps:
         assert _boundary_lines(ax) == [-4.0, 4.0], ax.get_title()
     for name in ("fracture_width", "fracture_footprints"):  # one legend entry per figure
-        legends = [ax.get_legend() for ax in out[name].axes if ax.get_legend() is not None]
+        legends = [ax.get_legend() for ax in out[name].axes if ax.get_legend() is not None] + out[name].legends
         assert ["layer boundary" in [t.get_text() for t in legend.get_texts()] for legend in legends] == [True]
+
+
+def test_a_long_low_footprint_is_drawn_with_its_depth_exaggerated_and_its_legend_outside():
+    """A footprint 15 times as long as high (the main demo's 2 480 x 180 ft) is drawn at 4x depth, said in the
+    title, with the legend below the axes, not over the outlines; one no longer than 4 times its height to scale."""
+    from types import SimpleNamespace
+
+    from hfgpu.io.plots import vertical_exaggeration
+
+    frame = SimpleNamespace(dx=10.0, dz=10.0)
+    strip = np.zeros((20, 200))
+    strip[2:12, 20:170] = 1.0   # 1 500 x 100
+    assert vertical_exaggeration([SimpleNamespace(width=strip, frame=frame)]) == 4.0
+    square = np.zeros((20, 20))
+    square[2:12, 2:40] = 1.0    # 180 x 100
+    assert vertical_exaggeration([SimpleNamespace(width=square, frame=frame)]) == 1.0
+    assert vertical_exaggeration([SimpleNamespace(width=np.zeros((3, 3)), frame=frame)]) == 1.0
+
+
+def test_the_status_banner_names_each_kind_once_and_fits_the_figure():
+    """Unphysical-state messages hold "; " inside them (hfgpu.proppant.health); the banner keeps one entry per
+    kind, "<kind> at t = <time> s", wrapped to the figure's width."""
+    from types import SimpleNamespace
+
+    from hfgpu.io.plots import BANNER_WIDTH, status_banner
+
+    found = ("proppant in cells narrower than a grain at t = 730.8 s: theta_p 0.0111 in the cell at x = -1 160 ft, "
+             "0.002556 in wide, below the smallest grain (0.004173 in); the cell is closing around its proppant; "
+             "theta_p above close packing at t = 1 838 s: theta_p 0.661 (close packing 0.6) in the cell at x = 50 ft")
+    banner = status_banner(SimpleNamespace(status="complete", summary={"proppant_unphysical_states": found}))
+    assert banner == ("unphysical states: proppant in cells narrower than a grain at t = 730.8 s; theta_p above "
+                      "close\npacking at t = 1 838 s")
+    assert max(len(line) for line in banner.splitlines()) <= BANNER_WIDTH
 
 
 def test_time_panels_share_one_colour_scale_and_no_nan_titles(layered):
