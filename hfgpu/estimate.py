@@ -28,12 +28,14 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from .units import display_unit, format_number, in_display_units
+from .units import display_text, format_number
 
 #: Cells from the perforation the fracture should reach by the end of pumping.
 MIN_CELLS_RADIUS = 3
 #: Fluid efficiency (volume in the fracture / pumped) below which leak-off is said to dominate.
 MIN_EFFICIENCY = 0.05
+#: Significant figures of the scales shown (estimates, not predictions).
+DIGITS = 3
 #: K' [Pa m^1/2] used for a rock without toughness (the closed form needs K' > 0; the viscosity-storage radius of
 #: a 0.1 m^3/s, 12 cP, E' 20 GPa fracture at 600 s is then within 0.2 % of Savitski & Detournay's 126.4 m).
 MIN_TOUGHNESS = 1e3
@@ -59,14 +61,9 @@ class Estimate:
 
 
 def pumped(schedule: Any) -> tuple[float, float]:
-    """(pumping time [s] to the end of the last stage with rate > 0, pumped volume [m^3])."""
-    end, volume, start = 0.0, 0.0, 0.0
-    for stage in schedule.stages:
-        if stage.rate > 0.0:
-            volume += stage.rate * (stage.until - start)
-            end = stage.until
-        start = stage.until
-    return end, volume
+    """(pumping time [s] to the end of the last stage with rate > 0, pumped volume [m^3]); (0, 0) without one."""
+    end = schedule.pump_end or 0.0
+    return end, schedule.volume(end)
 
 
 def first_pumped(schedule: Any) -> dict[str, float]:
@@ -119,24 +116,21 @@ def estimate(scene: Any) -> Estimate | None:
                     parcels=parcels, parcel_updates=updates)
 
 
-def _shown(value: float, kind: str, system: str) -> str:
-    return f"{format_number(in_display_units(value, kind, system), 3)} {display_unit(kind, system)}"
-
-
 def report(scene: Any, system: str) -> str:
     """The lines ``hfgpu check`` prints under "expected" ("" when :func:`estimate` has nothing to say)."""
     e = estimate(scene)
     if e is None:
         return ""
     minutes = format_number(e.pumping_time / 60.0, 3)
-    lines = [f"expected (a radial fracture at the mean rate {_shown(e.rate, 'rate', system)} in the rock at the "
-             "injection depth, Dontsov 2016; layers ignored; docs/scene.md):",
-             f"  {'at the end of pumping':32} {minutes} min: radius {_shown(e.radius, 'length', system)}, "
-             f"opening at the perforation {_shown(e.opening, 'width', system)}, fluid efficiency "
+    rate, radius = display_text(e.rate, "rate", system, DIGITS), display_text(e.radius, "length", system, DIGITS)
+    lines = [f"expected (a radial fracture at the mean rate {rate} in the rock at the injection depth, Dontsov 2016; "
+             "layers ignored; docs/scene.md):",
+             f"  {'at the end of pumping':32} {minutes} min: radius {radius}, "
+             f"opening at the perforation {display_text(e.opening, 'width', system, DIGITS)}, fluid efficiency "
              f"{format_number(100.0 * e.efficiency, 2)} %",
              f"  {'fracture cells':32} ~{format_number(e.cells, 2)} (pi R^2 / cell area)"]
     for name, (t, w0) in e.first_openings.items():
-        lines.append(f"  {'opening when ' + name + ' starts':32} {_shown(w0, 'width', system)} "
+        lines.append(f"  {'opening when ' + name + ' starts':32} {display_text(w0, 'width', system, DIGITS)} "
                      f"(t = {format_number(t / 60.0, 3)} min)")
     if e.proppant_steps is not None:
         work = f"~{format_number(e.proppant_steps, 2)} (dt_max or the fluid Courant step at the perforation)"
@@ -155,15 +149,16 @@ def warnings(scene: Any, system: str) -> list[str]:
     found = []
     cell = max(scene.mesh.dx, scene.mesh.dz)
     if e.radius < MIN_CELLS_RADIUS * cell:
-        found.append(f"injection.schedule: the fracture is expected to reach about {_shown(e.radius, 'length', system)}"
-                     f" from the perforation by the end of pumping (a radial estimate, Dontsov 2016), fewer than "
-                     f"{MIN_CELLS_RADIUS} cells of {_shown(cell, 'length', system)}: the grid does not resolve it; "
+        radius, side = display_text(e.radius, "length", system, DIGITS), display_text(cell, "length", system, DIGITS)
+        found.append(f"injection.schedule: the fracture is expected to reach about {radius} from the perforation by "
+                     f"the end of pumping (a radial estimate, Dontsov 2016), fewer than "
+                     f"{MIN_CELLS_RADIUS} cells of {side}: the grid does not resolve it; "
                      "use finer cells ([mesh] cell_size) or a higher rate")
     if e.efficiency < MIN_EFFICIENCY:
         found.append(f"injection.schedule: only about {format_number(100.0 * e.efficiency, 2)} % of the pumped fluid "
                      f"is expected in the fracture at the end of pumping (rock.leakoff_coefficient at the injection "
-                     f"depth, mean rate {_shown(e.rate, 'rate', system)}): leak-off takes nearly all of it and the "
-                     "fracture stays small; a higher rate or a lower leak-off opens it")
+                     f"depth, mean rate {display_text(e.rate, 'rate', system, DIGITS)}): leak-off takes nearly all of "
+                     "it and the fracture stays small; a higher rate or a lower leak-off opens it")
     if scene.proppant is None:
         return found
     factor = scene.proppant.params.bridging_factor
@@ -172,9 +167,11 @@ def warnings(scene: Any, system: str) -> list[str]:
             continue
         t, w0 = e.first_openings[spec.name]
         if factor * spec.size.d_max > w0:
-            found.append(f"proppant[{i}] ({spec.name}): its largest grain {_shown(spec.size.d_max, 'width', system)} "
+            grain = display_text(spec.size.d_max, "width", system, DIGITS)
+            opening = display_text(w0, "width", system, DIGITS)
+            found.append(f"proppant[{i}] ({spec.name}): its largest grain {grain} "
                          f"x bridging_factor {factor:g} exceeds the expected opening at the perforation when it is "
-                         f"first pumped, {_shown(w0, 'width', system)} at {format_number(t / 60.0, 3)} min (a radial "
+                         f"first pumped, {opening} at {format_number(t / 60.0, 3)} min (a radial "
                          "estimate, Dontsov 2016): it bridges at the inlet unless the fracture is wider; a longer "
                          "pad, a higher rate or viscosity, or a finer grain")
     return found

@@ -37,7 +37,7 @@ from .estimate import report as expected_report
 from .estimate import warnings as expected_warnings
 from .scene import Scene, load_scene
 from .scene_reader import raise_all
-from .units import display_unit, format_number, in_display_units
+from .units import display_text, display_unit, format_number, in_display_units
 
 #: Cells (dz in use) a layer the fracture enters should span at least.
 MIN_CELLS_ACROSS = 3
@@ -68,10 +68,6 @@ def print_warnings(scene: Scene, file: TextIO | None = None) -> None:
         print(f"hfgpu: warning: {' '.join(line.splitlines())}", file=out, flush=True)
 
 
-def _length(value: float, system: str, kind: str = "length") -> str:
-    return f"{format_number(in_display_units(value, kind, system))} {display_unit(kind, system)}"
-
-
 def review(scene: Scene) -> list[str]:
     """The warnings of the module docstring, in that order, in the scene's output units."""
     system = scene.output.units
@@ -94,9 +90,10 @@ def _preset_coarsens(scene: Scene, system: str) -> list[str]:
     if refinement >= 1.0 or not scene.source or (isinstance(mesh, dict) and "refinement" in mesh):
         return []
     dx, dz = scene.mesh.scene_cell_size
-    given = _length(dx, system) if dx == dz else f"{_length(dx, system)} x {_length(dz, system)}"
-    used = _length(scene.mesh.dx, system) if dx == dz else \
-        f"{_length(scene.mesh.dx, system)} x {_length(scene.mesh.dz, system)}"
+    given = display_text(dx, 'length', system) if dx == dz else \
+        f"{display_text(dx, 'length', system)} x {display_text(dz, 'length', system)}"
+    used = display_text(scene.mesh.dx, 'length', system) if dx == dz else \
+        f"{display_text(scene.mesh.dx, 'length', system)} x {display_text(scene.mesh.dz, 'length', system)}"
     return [f"preset \"{scene.run.preset}\" coarsens the cells: [mesh] cell_size {given} is run as {used} "
             f"(refinement {refinement:g}); add 'refinement = 1' to [mesh] to keep your cells"]
 
@@ -131,8 +128,9 @@ def _layers(scene: Scene, system: str) -> list[str]:
     tops, bottoms = [layer.top for _, layer in ordered], [layer.bottom for _, layer in ordered]
     if depth < tops[0] or depth > bottoms[-1]:
         side, edge = ("above", tops[0]) if depth < tops[0] else ("below", bottoms[-1])
-        found.append(f"injection.depth {_length(depth, system, 'depth')} lies {side} every layer of [[rock.layers]] "
-                     f"({_length(tops[0], system, 'depth')} to {_length(bottoms[-1], system, 'depth')}): the "
+        found.append(f"injection.depth {display_text(depth, 'depth', system)} lies {side} every layer of "
+                     "[[rock.layers]] "
+                     f"({display_text(tops[0], 'depth', system)} to {display_text(bottoms[-1], 'depth', system)}): the "
                      f"{'top' if side == 'above' else 'bottom'} layer's properties are extended to it")
     found += _off_face(scene, system, ordered)
     at = next((k for k, (_, layer) in enumerate(ordered) if layer.top <= depth < layer.bottom), None)
@@ -141,8 +139,8 @@ def _layers(scene: Scene, system: str) -> list[str]:
         i, layer = ordered[k]
         cells = (layer.bottom - layer.top) / dz
         if cells < MIN_CELLS_ACROSS:
-            found.append(f"rock.layers[{i}] ({_length(layer.bottom - layer.top, system)} thick) is "
-                         f"{format_number(cells, 2)} cells of {_length(dz, system)} across, fewer than "
+            found.append(f"rock.layers[{i}] ({display_text(layer.bottom - layer.top, 'length', system)} thick) is "
+                         f"{format_number(cells, 2)} cells of {display_text(dz, 'length', system)} across, fewer than "
                          f"{MIN_CELLS_ACROSS}: the fracture enters it; use finer cells")
     return found
 
@@ -155,11 +153,12 @@ def _off_face(scene: Scene, system: str, ordered: list) -> list[str]:
     depth, dz, refinement = scene.injection.depth, scene.mesh.dz, scene.mesh.refinement
     fit = fit_layers(depth, dz, layer_boundaries(scene.rock.layers))
     if fit.honouring is None:
-        remedy = (f"no cell height from {_length(dz / HONOURING_RANGE, system)} to {_length(dz, system)} puts every "
+        remedy = (f"no cell height from {display_text(dz / HONOURING_RANGE, 'length', system)} to "
+                  f"{display_text(dz, 'length', system)} puts every "
                   "layer boundary on a face")
     else:
-        setting = _length(fit.honouring * refinement, system)
-        remedy = (f"cells {_length(fit.honouring, system)} tall ([mesh] cell_size height {setting}"
+        setting = display_text(fit.honouring * refinement, 'length', system)
+        remedy = (f"cells {display_text(fit.honouring, 'length', system)} tall ([mesh] cell_size height {setting}"
                   f"{'' if refinement == 1.0 else f' / refinement {refinement:g}'}) put every layer boundary on a "
                   "face")
     found = []
@@ -167,10 +166,11 @@ def _off_face(scene: Scene, system: str, ordered: list) -> list[str]:
         keys = [f"rock.layers[{i}].{key}" for k, (i, layer) in enumerate(ordered)
                 for key, value, outer in (("top", layer.top, k == 0), ("bottom", layer.bottom, k == len(ordered) - 1))
                 if value == boundary and not outer]
-        found.append(f"{' = '.join(keys)} {_length(boundary, system, 'depth')} is not on a cell face: the grid's "
-                     f"faces (cells {_length(dz, system)} tall) are placed on the boundary at "
-                     f"{_length(fit.anchor, system, 'depth')}, the nearest to injection.depth "
-                     f"{_length(depth, system, 'depth')}, so a row straddles {_length(boundary, system, 'depth')} "
+        found.append(f"{' = '.join(keys)} {display_text(boundary, 'depth', system)} is not on a cell face: the grid's "
+                     f"faces (cells {display_text(dz, 'length', system)} tall) are placed on the boundary at "
+                     f"{display_text(fit.anchor, 'depth', system)}, the nearest to injection.depth "
+                     f"{display_text(depth, 'depth', system)}, so a row straddles "
+                     f"{display_text(boundary, 'depth', system)} "
                      f"with the properties at its centre; {remedy}")
     return found
 
