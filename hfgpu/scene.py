@@ -154,6 +154,12 @@ class Schedule:
     def end(self) -> float:
         return self.stages[-1].until if self.stages else 0.0
 
+    @property
+    def pump_end(self) -> float | None:
+        """The time [s] the pumps stop: the end of the last stage pumping at a rate > 0; None when none does."""
+        pumping = [stage.until for stage in self.stages if stage.rate > 0.0]
+        return float(pumping[-1]) if pumping else None
+
     def stage_index(self, t: float) -> int:
         """Index of the stage active during (t_prev, t]; -1 after the last stage (shut in)."""
         for i, stage in enumerate(self.stages):

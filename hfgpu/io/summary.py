@@ -82,9 +82,7 @@ def _proppant_amount(value: Any, density: float | None, system: str) -> str | No
 
 def pump_end(scene: Any) -> float | None:
     """The time [s] the pumps stop: the end of the last stage pumping at a rate > 0; None without a schedule."""
-    stages = scene.injection.schedule.stages if getattr(scene, "injection", None) is not None else ()
-    pumping = [stage.until for stage in stages if stage.rate > 0.0]
-    return float(pumping[-1]) if pumping else None
+    return scene.injection.schedule.pump_end if getattr(scene, "injection", None) is not None else None
 
 
 def treatment_pressures(balance: dict[str, np.ndarray], stop: float | None,
