@@ -6,17 +6,11 @@ import numpy as np
 import pytest
 
 from hfgpu.kernels.closures import damping
-from hfgpu.kernels.runtime import init, ti
+from hfgpu.kernels.runtime import ti
 
+pytestmark = pytest.mark.usefixtures("taichi_cpu")
 F1 = ti.types.ndarray(dtype=ti.f64, ndim=1)
 THETA_CP, EPSILON, RESTITUTION, THRESHOLD = 0.6, 1e-7, 0.9, 0.8
-
-
-@pytest.fixture(autouse=True, scope="module")
-def taichi_cpu():
-    """Taichi on the CPU backend, started when the tests run rather than when pytest collects this module (a
-    start during collection makes tests/kernels/test_elementary.py's NumPy log of subnormals give -inf)."""
-    init("cpu")
 
 
 @ti.kernel

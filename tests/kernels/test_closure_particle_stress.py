@@ -5,16 +5,10 @@ import numpy as np
 import pytest
 
 from hfgpu.kernels.closures import particle_stress
-from hfgpu.kernels.runtime import init, ti
+from hfgpu.kernels.runtime import ti
 
+pytestmark = pytest.mark.usefixtures("taichi_cpu")
 F1 = ti.types.ndarray(dtype=ti.f64, ndim=1)
-
-
-@pytest.fixture(autouse=True, scope="module")
-def taichi_cpu():
-    """Taichi on the CPU backend, started when the tests run rather than when pytest collects this module (a
-    start during collection makes tests/kernels/test_elementary.py's NumPy log of subnormals give -inf)."""
-    init("cpu")
 
 
 @ti.kernel
