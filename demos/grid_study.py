@@ -30,12 +30,13 @@ import numpy as np  # noqa: E402
 from field_case import load, propped_area_panel, save  # noqa: E402  (demos/ is on sys.path as a script)
 
 from hfgpu import edit_scene, open_results, run  # noqa: E402
+from hfgpu.presets import BALANCED  # noqa: E402
 from hfgpu.propped import GROUPS, created_area, packed_fraction, parcel_groups, propped_cells  # noqa: E402
 
 #: "Converged" here: the propped area within this share of the finest grid's.
 TOLERANCE = 0.05
-#: Parcels per cell on every grid (balanced's value; so 4x the parcels per halving of the cells).
-PARCELS_PER_CELL = 16
+#: Parcels per cell on every grid (the balanced preset's; so 4x the parcels per halving of the cells).
+PARCELS_PER_CELL = BALANCED.parcels_per_cell
 
 
 def scene_for(cells: float, end: float, size: str | None):
