@@ -9,7 +9,9 @@ which the front reconstructed from the widths (front.front_distances, the tip as
 cells) moves more than ``max_front_advance`` cells, is redone with half the step.
 
 The footprint counts an edge cell by the part of it behind the straight front at the inverted tip distance
-(geometry.filled_fraction with ``distances``); a coarsening carries no front (every coarse cell a channel cell,
+(geometry.filled_fraction with ``distances``), the distances of the solved cells: a cell opened at the view's
+time (width 0, ``Grid.unsolved``) counts only the part of it the front of its solved neighbours reaches past
+their shared face (the criterion opened it when that front reached the face); a coarsening carries no front (every coarse cell a channel cell,
 the next step's distances place it again).
 """
 
@@ -52,10 +54,13 @@ class CellFront:
         return dt
 
     def filled_fraction(self, engine, view: View) -> np.ndarray:
-        """Each box cell's filled fraction: edge cells by their inverted tip distances (geometry.py)."""
+        """Each box cell's filled fraction: the solved cells' edges by their inverted tip distances, a cell
+        opened at the view's time by the part of it that front reaches (module docstring, geometry.py)."""
         g = view.grid
-        return filled_fraction(self.name, g["active"], g["fill"], distances(engine, view), g.dx, g.dz,
-                               g.shut(view.t))
+        solved = g["active"] & ~g.unsolved(view.t)
+        found = front_distances(engine.tip, solved, g["w"], g["p"], view.kprime_box, view.cprime_box,
+                                g["reached"], view.t, g.dx, g.dz)
+        return filled_fraction(self.name, solved, g["fill"], found, g.dx, g.dz, g.shut(view.t))
 
     def tip_normals(self, engine, view: View) -> tuple[np.ndarray, None, None]:
         """No tip cells (the front lies on cell edges): an all-False mask and no normals."""

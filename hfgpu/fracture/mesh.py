@@ -175,6 +175,10 @@ class Grid:
         has not been solved yet). They start a step closed (newton.solve_step) and count no area (geometry.py)."""
         return self.fields["active"] & (self.fields["w"] <= 0.0) & (self.fields["opened"] < t)
 
+    def unsolved(self, t: float) -> np.ndarray:
+        """Active cells the front criterion opened at time t (or later) that no solve has seen yet: width 0."""
+        return self.fields["active"] & (self.fields["w"] <= 0.0) & (self.fields["opened"] >= t)
+
     def ensure_margin(self, margin: int = 2) -> None:
         """Grow the box by GROW cells on every side an active cell comes within ``margin`` cells of."""
         rows, cols = np.nonzero(self.fields["active"])

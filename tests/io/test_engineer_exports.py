@@ -197,15 +197,15 @@ def test_the_summary_height_of_a_known_footprint_is_its_open_rows():
     assert rows["created area (one face)"] == "6 000 ft^2"
 
 
-@pytest.mark.xfail(strict=True, reason="the fracture engine counts half a row for each barrier row the front "
-                   "reached and contact closed at the last step (hfgpu.fracture.geometry, cells front): 60 ft for "
-                   "5 open rows; fix in the engine (see the issue 31 report), then drop this mark")
-def test_the_summary_height_is_the_extent_of_the_open_rows(fracture_run):
+def test_the_summary_height_is_the_open_rows_and_the_front_past_them(fracture_run):
+    """5 open rows of 10 ft between 1000 psi barriers: the height is 50 ft plus the part of the barrier rows the
+    front of the solved cells reaches (geometry.py), under half a cell in all; the barrier cells the front
+    criterion opened at the last step (width 0, not yet solved) count only that part, not half a row each."""
     path, stdout, _ = fracture_run
     snap = open_results(path).fracture_snapshots[-1]
-    open_rows = int((snap.width > 0).sum(axis=0).max())
+    assert int((snap.width > 0).sum(axis=0).max()) == 5
     line = next(x for x in stdout.splitlines() if x.strip().startswith("height"))
-    assert open_rows == 5 and line.split()[-2:] == [format_number(open_rows * 10.0), "ft"]
+    assert line.split()[-1] == "ft" and 50.0 <= float(line.split()[-2]) < 55.0, line
 
 
 def test_the_summary_speaks_one_style_in_field_units(fracture_run):
