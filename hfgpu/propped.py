@@ -121,11 +121,11 @@ def packed_fraction(parcels: dict[str, np.ndarray], speed_threshold: float = PAC
 
 
 def shields_ratio(snap: ProppantSnapshot, setup: Any, fluid_density: float, viscosity: float) -> np.ndarray:
-    """Per parcel, its Shields number over the critical one (hfgpu.proppant.closures): tau_b = f_t sqrt(12) mu
+    """Per parcel, its Shields number over the critical one (hfgpu.kernels.closures.bed): tau_b = f_t sqrt(12) mu
     |u_f| / w of the fluid's x velocity u_f at the parcel (linear between its cell's x faces) and its cell's
     width w; below 1 the grain would rest on a bed surface. ``setup`` is the scene's ProppantSetup."""
-    from .proppant import closures
-    from .proppant.interpolation import owning_cell
+    from .kernels.closures import bed
+    from .kernels.stencil_numpy import owning_cell
 
     p, f = snap.parcels, snap.frame
     width = np.asarray(snap.grid["width"])
@@ -134,10 +134,10 @@ def shields_ratio(snap: ProppantSnapshot, setup: Any, fluid_density: float, visc
     a = np.clip((p["x"] - f.x0) / f.dx + 0.5 - i, 0.0, 1.0)
     u_f = fluid_u[k, i] + a * (fluid_u[k, i + 1] - fluid_u[k, i])
     diameter, rho_p, g = 2.0 * np.asarray(p["radius"]), np.asarray(p["density"]), setup.numerics.gravity
-    tau = closures.bed_shear_stress(u_f, np.maximum(width[k, i], 1e-300), fluid_density, viscosity,
-                                    setup.params.wall_friction)
-    return closures.shields_number(tau, diameter, rho_p, fluid_density, g) \
-        / closures.critical_shields_number(diameter, rho_p, fluid_density, viscosity, g)
+    tau = bed.bed_shear_stress_numpy(u_f, np.maximum(width[k, i], 1e-300), fluid_density, viscosity,
+                                     setup.params.wall_friction_code)
+    return bed.shields_number_numpy(tau, diameter, rho_p, fluid_density, g) \
+        / bed.critical_shields_number_numpy(diameter, rho_p, fluid_density, viscosity, g)
 
 
 def parcel_groups(snap: ProppantSnapshot, setup: Any, fluid_density: float, viscosity: float,

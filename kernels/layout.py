@@ -9,7 +9,7 @@ Parcels (capacity ``cap``; the first ``n`` columns are in use):
     P (PARCEL_ROWS, cap) float64: X, Z [m], U, V [m/s], RADIUS [m], DENSITY [kg/m^3], PARTICLES (per parcel)
     S (STATE_ROWS, cap) int32: STATE (SUSPENDED, BRIDGED, or GONE: left through an outlet, dropped by the next
         compaction), CLASS (index of the scene's proppant class)
-    W (WORK_ROWS, cap) float64, per sub-step: what the parcel sees (SEEN rows in the order of
+    W (WORK_ROWS, cap) float64, per sub-step: what the parcel sees (SEEN rows: SEEN_FIELDS, the fields of
         hfgpu.proppant.particle_ops_numpy.ParcelFluid), DRAG (D_p of its last implicit solve), LAG_X, LAG_Z
         (1 - r_p of the implicit drag, simulator module docstring)
 Grid (nz, nx cells):
@@ -21,9 +21,9 @@ Grid (nz, nx cells):
     FLAGS (nz, nx) int32: stencil_flags
 Deposit copies (private per parcel block on the CPU, one shared copy on a GPU):
     CD (copies, nz, nx, MOMENT_COUNT), XD (copies, nz, nx+1, 2), ZD (copies, nz+1, nx, 2): force, beta
-Scalars: PR (PARAM_COUNT) float64, the run's constants; ST (STAT_COUNT) float64, what the passes report: the
-sub-loop's outflow [m^3], parcels that left (ST_LEFT) and largest |u| + |v|, the first non-finite parcel, the
-sort's kept and dropped counts, the solid volume in the domain.
+Scalars: PR (PARAM_COUNT) float64, the run's constants (named by PARAMS); ST (STAT_COUNT) float64, what the
+passes report: the sub-loop's outflow [m^3], parcels that left (ST_LEFT) and largest |u| + |v|, the first
+non-finite parcel, the sort's kept and dropped counts, the solid volume in the domain.
 """
 
 # parcel rows (P): the float fields of hfgpu.proppant.parcels.Parcels, which builds its fields from these names
@@ -36,27 +36,79 @@ STATE, CLASS = range(len(INT_FIELDS))
 STATE_ROWS = len(INT_FIELDS)
 # parcel states (the STATE row, Parcels.state)
 SUSPENDED, BRIDGED, GONE = 0, 1, 2
-# per-parcel work rows (W): the SEEN rows first
-S_UF, S_VF, S_DPDX, S_DPDZ, S_DTDX, S_DTDZ, S_THETA, S_MEAN_U, S_MEAN_V, S_DAMPING, S_WIDTH = range(11)
-SEEN = 11
-DRAG, LAG_X, LAG_Z = 11, 12, 13
-WORK_ROWS = 14
+# per-parcel work rows (W): the SEEN rows first, what a parcel sees: the fields of
+# hfgpu.proppant.particle_ops_numpy.ParcelFluid, which builds its fields from these names
+SEEN_FIELDS = ("fluid_u", "fluid_v", "dpdx", "dpdz", "dtaudx", "dtaudz", "volume_fraction", "mean_u", "mean_v",
+               "damping_rate", "width")
+S_UF = SEEN_FIELDS.index("fluid_u")
+S_VF = SEEN_FIELDS.index("fluid_v")
+S_DPDX = SEEN_FIELDS.index("dpdx")
+S_DPDZ = SEEN_FIELDS.index("dpdz")
+S_DTDX = SEEN_FIELDS.index("dtaudx")
+S_DTDZ = SEEN_FIELDS.index("dtaudz")
+S_THETA = SEEN_FIELDS.index("volume_fraction")
+S_MEAN_U = SEEN_FIELDS.index("mean_u")
+S_MEAN_V = SEEN_FIELDS.index("mean_v")
+S_DAMPING = SEEN_FIELDS.index("damping_rate")
+S_WIDTH = SEEN_FIELDS.index("width")
+SEEN = len(SEEN_FIELDS)
+# then the implicit drag's rows
+WORK_FIELDS = SEEN_FIELDS + ("drag", "lag_x", "lag_z")
+DRAG = WORK_FIELDS.index("drag")
+LAG_X = WORK_FIELDS.index("lag_x")
+LAG_Z = WORK_FIELDS.index("lag_z")
+WORK_ROWS = len(WORK_FIELDS)
 
-# cell channels (C); the moment sums of the scatter come first, in hfgpu.proppant.particle_ops_numpy order
-M_VOLUME, M_MASS, M_MASS_U, M_MASS_V, M_MASS_SPEED2, M_NR3, M_NR2 = range(7)
-MOMENT_COUNT = 7
-WIDTH, CELL, PRESSURE, THETA, MEAN_U, MEAN_V, VARIANCE, SAUTER, TAU, DAMPING, OUTLET = range(7, 18)
-CELL_CHANNELS = 18
+# cell channels (C); the moment sums of the scatter come first: sums over parcels of solid volume n V_p, mass,
+# mass u, mass v, mass |u|^2, n r^3, n r^2 (hfgpu.proppant.particle_ops_numpy.moment_sums names its sums by these)
+MOMENT_FIELDS = ("volume", "mass", "mass_u", "mass_v", "mass_speed2", "n_r3", "n_r2")
+M_VOLUME = MOMENT_FIELDS.index("volume")
+M_MASS = MOMENT_FIELDS.index("mass")
+M_MASS_U = MOMENT_FIELDS.index("mass_u")
+M_MASS_V = MOMENT_FIELDS.index("mass_v")
+M_MASS_SPEED2 = MOMENT_FIELDS.index("mass_speed2")
+M_NR3 = MOMENT_FIELDS.index("n_r3")
+M_NR2 = MOMENT_FIELDS.index("n_r2")
+MOMENT_COUNT = len(MOMENT_FIELDS)
+WIDTH, CELL, PRESSURE, THETA, MEAN_U, MEAN_V, VARIANCE, SAUTER, TAU, DAMPING, OUTLET = range(MOMENT_COUNT,
+                                                                                            MOMENT_COUNT + 11)
+CELL_CHANNELS = OUTLET + 1
 # face channels (XF, ZF): the same for both face sets
 F_MASK, F_WIDTH, F_VELOCITY, F_DP, F_DTAU, F_FORCE, F_BETA = range(7)
 FACE_CHANNELS = 7
 DEPOSIT_FORCE, DEPOSIT_BETA = range(2)
 
-# run constants (PR)
-(P_X0, P_Z0, P_DX, P_DZ, P_THETA_CP, P_EPSILON, P_PACKING_RESTITUTION, P_DRAG_LAW, P_RE_COEFFICIENT,
- P_BRIDGING, P_DRAG_ITERATIONS, P_BED_FRICTION, P_FRICTION_FRACTION, P_SHIELDS, P_WALL_LAW, P_RHO_F, P_MU,
- P_GRAVITY, P_STRESS_P, P_STRESS_BETA, P_RESTITUTION, P_DAMPING, P_DAMPING_THRESHOLD) = range(23)
-PARAM_COUNT = 23
+# run constants (PR), filled by name (hfgpu.proppant.engine_taichi.param_vector): a name that is an attribute of
+# hfgpu.proppant.params.MppicParams takes that attribute's value; the others are the run's: the grid frame's x0,
+# z0, dx, dz, the fluid's density rho_f [kg/m^3] and viscosity mu_f [Pa s], gravity [m/s^2]
+PARAMS = ("x0", "z0", "dx", "dz", "theta_cp", "epsilon", "packing_restitution", "drag_law_code",
+          "drag_re_coefficient", "bridging_factor", "drag_iterations", "bed_friction", "friction_volume_fraction",
+          "shields_deposition", "wall_friction_code", "rho_f", "mu_f", "gravity", "P_s", "beta", "restitution",
+          "damping", "damping_threshold")
+P_X0 = PARAMS.index("x0")
+P_Z0 = PARAMS.index("z0")
+P_DX = PARAMS.index("dx")
+P_DZ = PARAMS.index("dz")
+P_THETA_CP = PARAMS.index("theta_cp")
+P_EPSILON = PARAMS.index("epsilon")
+P_PACKING_RESTITUTION = PARAMS.index("packing_restitution")
+P_DRAG_LAW = PARAMS.index("drag_law_code")
+P_RE_COEFFICIENT = PARAMS.index("drag_re_coefficient")
+P_BRIDGING = PARAMS.index("bridging_factor")
+P_DRAG_ITERATIONS = PARAMS.index("drag_iterations")
+P_BED_FRICTION = PARAMS.index("bed_friction")
+P_FRICTION_FRACTION = PARAMS.index("friction_volume_fraction")
+P_SHIELDS = PARAMS.index("shields_deposition")
+P_WALL_LAW = PARAMS.index("wall_friction_code")
+P_RHO_F = PARAMS.index("rho_f")
+P_MU = PARAMS.index("mu_f")
+P_GRAVITY = PARAMS.index("gravity")
+P_STRESS_P = PARAMS.index("P_s")
+P_STRESS_BETA = PARAMS.index("beta")
+P_RESTITUTION = PARAMS.index("restitution")
+P_DAMPING = PARAMS.index("damping")
+P_DAMPING_THRESHOLD = PARAMS.index("damping_threshold")
+PARAM_COUNT = len(PARAMS)
 # sub-loop reports (ST)
 ST_OUTFLOW, ST_SPEED, ST_BAD_STEP, ST_BAD_PARCEL, ST_GONE, ST_LIVE, ST_VOLUME, ST_LEFT = range(8)
 STAT_COUNT = 8

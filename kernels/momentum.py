@@ -1,15 +1,15 @@
 """Taichi kernel of the fluid momentum predictor (the paper, Eq. 26 / 49 with Eq. 62-65 and Eq. 9).
 
 Same arithmetic, conventions and signature as the NumPy reference :mod:`hfgpu.proppant.momentum` (read its
-module docstring, also for the wall-friction factor f_t of "dean"): one thread per face control volume; the z
-component runs the x kernel on the transposed grid. Inputs and outputs are NumPy float64 arrays.
+module docstring; the wall-friction factor f_t is hfgpu.kernels.closures.wall_friction's): one thread per face
+control volume; the z component runs the x kernel on the transposed grid. Inputs and outputs are NumPy float64 arrays.
 """
 
 
 import numpy as np
 
 from hfgpu.kernels.runtime import init, ti
-from hfgpu.kernels.wall_friction import DEAN_COEFFICIENT, wall_friction_code
+from hfgpu.kernels.closures.wall_friction import wall_friction_code, wall_friction_factor
 
 F64_2D = ti.types.ndarray(dtype=ti.f64, ndim=2)
 
@@ -31,16 +31,6 @@ def _old_q(width0: ti.template(), theta_f0: ti.template(), k, i):
     if width0[k, i] > 0.0:
         q = theta_f0[k, i] * width0[k, i]
     return q
-
-
-@ti.func
-def wall_friction_factor(speed: ti.f64, width: ti.f64, mu: ti.f64, rho: ti.f64, dean: ti.i32) -> ti.f64:
-    """f_t of :func:`hfgpu.proppant.momentum.wall_friction_factor`: 1 (laminar, Eq. 9), or with dean = 1
-    max(1, (0.073/12) Re^(3/4)), Re = rho |U| w / mu (Dean 1978)."""
-    f_t = 1.0
-    if dean == 1:
-        f_t = ti.max(1.0, DEAN_COEFFICIENT / 12.0 * (rho * speed * width / mu) ** 0.75)
-    return f_t
 
 
 @ti.kernel

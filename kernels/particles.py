@@ -9,7 +9,7 @@ Push: one task per LANES consecutive parcels; their drag solves (Eq. 43) run as 
 independent dependency chains of the parcels interleave (one parcel's fixed-point iteration is a serial chain
 of sqrt, log, exp and a division); then bed friction, bridging and the move (Eq. 44, walls) parcel by parcel.
 The drag and the packing limiter are the closures' Taichi twins (hfgpu.kernels.closures.drag, particle_stress),
-evaluated on LANES-wide vectors.
+evaluated on LANES-wide vectors; bed friction and the threshold of motion are hfgpu.kernels.closures.bed's.
 
 Fast paths (per-cell bits of stencil.cell_flags): a parcel whose cell and its 8 neighbours are open and inside
 the grid (INTERIOR) uses plain bilinear weights without mask reads in the gather (scatter and exchange weight
@@ -26,19 +26,20 @@ results are deterministic, and random parcel order costs little more than sorted
 varies from run to run); the engine keeps the parcels sorted by cell, so runs are long and atomics few.
 """
 
-from hfgpu.kernels.closures import drag, particle_stress
+from hfgpu.kernels.closures import bed, drag, particle_stress
+from hfgpu.kernels.closures.walls import blocked
 from hfgpu.kernels.layout import (
     PARAM_COUNT,
+    M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME, MOMENT_COUNT,
     BRIDGED, CELL, DAMPING, DENSITY, DRAG, F_DP, F_DTAU, F_MASK, F_VELOCITY, GONE, LAG_X, LAG_Z, MEAN_U,
     F_WIDTH, MEAN_V, OUTLET, P_BED_FRICTION, P_BRIDGING, P_DAMPING_THRESHOLD, P_DRAG_ITERATIONS, P_DRAG_LAW, P_DX, P_DZ,
     P_EPSILON, P_FRICTION_FRACTION, P_GRAVITY, P_MU, P_PACKING_RESTITUTION, P_RE_COEFFICIENT, P_RHO_F, P_SHIELDS,
     P_THETA_CP, P_WALL_LAW, P_X0, P_Z0, PARTICLES, RADIUS, S_DAMPING, S_DPDX, S_DPDZ, S_DTDX, S_DTDZ, S_MEAN_U,
     S_MEAN_V, S_THETA, S_UF, S_VF, S_WIDTH, SEEN, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW, ST_SPEED,
     ST_VOLUME, STATE, SUSPENDED, THETA, U, V, WIDTH, X, Z)
-from hfgpu.kernels.momentum import wall_friction_factor
 from hfgpu.kernels.runtime import ti
 from hfgpu.kernels.stencil import (
-    INTERIOR, LOOSE, NO_RUN, QUIET, bilinear, block_range, blocked, closed, flush, free_grains, owner,
+    INTERIOR, LOOSE, NO_RUN, QUIET, bilinear, block_range, closed, flush, free_grains, owner,
     owner_flags, run_sum, sample, volume_weights)
 
 PI = 3.141592653589793
@@ -88,19 +89,20 @@ def report_block(BS: ti.template(), ST: ti.template(), block: ti.i32, row: ti.te
 def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template(), FLAGS: ti.template(),
                  CD: ti.template(), BS: ti.template(), blocks: ti.i32, private: ti.template(), PR: ti.template(),
                  ST: ti.template()):
-    """Bilinear sums of volume, mass, mass u, mass v, mass |u|^2, n r^3, n r^2 (Eq. 38) into CD (copies, nz, nx,
-    7) (channel last: a node's sums share a cache line), which the caller zeroes and sums over copies; the
-    solid volume of each block's parcels into BS[0, block] (the domain's solid volume, summed by the caller in
-    block order: the same on every run) and their largest |u| + |v| into BS[2, block]; with shared copies (a
-    GPU: many blocks) both go straight into ST[ST_VOLUME], ST[ST_SPEED] with atomics instead. Each block sums
-    in registers while the stencil base stays the same."""
+    """Bilinear sums of volume, mass, mass u, mass v, mass |u|^2, n r^3, n r^2 (Eq. 38; channels M_VOLUME, ...,
+    layout.MOMENT_FIELDS) into CD (copies, nz, nx, MOMENT_COUNT) (channel last: a node's sums share a cache
+    line), which the caller zeroes and sums over copies; the solid volume of each block's parcels into
+    BS[0, block] (the domain's solid volume, summed by the caller in block order: the same on every run) and
+    their largest |u| + |v| into BS[2, block]; with shared copies (a GPU: many blocks) both go straight into
+    ST[ST_VOLUME], ST[ST_SPEED] with atomics instead. Each block sums in registers while the stencil base stays
+    the same."""
     spread = ti.static(SPREAD if private else 1)
     for t in range(blocks * spread):
         if t % spread == 0:
             block = t // spread
             copy = block if ti.static(private) else 0
             start, end = block_range(block, blocks, n, private)
-            acc = ti.Matrix.zero(ti.f64, 4, 7)
+            acc = ti.Matrix.zero(ti.f64, 4, MOMENT_COUNT)
             kb = NO_RUN
             ib = NO_RUN
             total = 0.0
@@ -109,21 +111,27 @@ def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template()
                 if S[STATE, p] != GONE:
                     sx, sz = cell_coordinates(P, p, PR)
                     k0, i0, w = volume_weights(sx, sz, 0.0, 0.0, C, CELL, WIDTH)
-                    acc, kb, ib = run_sum(CD, copy, k0, i0, kb, ib, acc, 7, private)
+                    acc, kb, ib = run_sum(CD, copy, k0, i0, kb, ib, acc, MOMENT_COUNT, private)
                     r = P[RADIUS, p]
                     n_p = P[PARTICLES, p]
                     vol = n_p * (4.0 / 3.0 * PI * r ** 3)
                     mass = vol * P[DENSITY, p]
                     u = P[U, p]
                     v = P[V, p]
-                    vals = ti.Vector([vol, mass, mass * u, mass * v, mass * (u ** 2 + v ** 2), n_p * r ** 3,
-                                      n_p * r ** 2], dt=ti.f64)
+                    vals = ti.Vector.zero(ti.f64, MOMENT_COUNT)  # by channel name (layout.MOMENT_FIELDS)
+                    vals[M_VOLUME] = vol
+                    vals[M_MASS] = mass
+                    vals[M_MASS_U] = mass * u
+                    vals[M_MASS_V] = mass * v
+                    vals[M_MASS_SPEED2] = mass * (u ** 2 + v ** 2)
+                    vals[M_NR3] = n_p * r ** 3
+                    vals[M_NR2] = n_p * r ** 2
                     total += vol
                     fastest = ti.max(fastest, ti.abs(u) + ti.abs(v))
                     for j in ti.static(range(4)):
-                        for c in ti.static(range(7)):
+                        for c in ti.static(range(MOMENT_COUNT)):
                             acc[j, c] += vals[c] * w[j]
-            flush(CD, copy, kb, ib, acc, 7, private)
+            flush(CD, copy, kb, ib, acc, MOMENT_COUNT, private)
             report_block(BS, ST, block, 0, ST_VOLUME, total, fastest, private)
 
 
@@ -142,12 +150,19 @@ def seen_at(sx: ti.f64, sz: ti.f64, interior: ti.template(), C: ti.template(), X
     if k >= 0 and k < C.shape[1] and i >= 0 and i < C.shape[2]:
         own = C[WIDTH, k, i]
         free = free_grains(C[THETA, k, i], PR)
-    return ti.Vector([sample(XF, F_VELOCITY, kx, ix, wx, interior), sample(ZF, F_VELOCITY, kz, iz, wz, interior),
-                      free * sample(XF, F_DP, kx, ix, wx, interior), free * sample(ZF, F_DP, kz, iz, wz, interior),
-                      sample(XF, F_DTAU, kx, ix, wx, interior), sample(ZF, F_DTAU, kz, iz, wz, interior),
-                      sample(C, THETA, kc, ic, wc, interior), sample(C, MEAN_U, kc, ic, wc, interior),
-                      sample(C, MEAN_V, kc, ic, wc, interior), sample(C, DAMPING, kc, ic, wc, interior), own],
-                     dt=ti.f64)
+    s = ti.Vector.zero(ti.f64, SEEN)  # by row name (layout.SEEN_FIELDS)
+    s[S_UF] = sample(XF, F_VELOCITY, kx, ix, wx, interior)
+    s[S_VF] = sample(ZF, F_VELOCITY, kz, iz, wz, interior)
+    s[S_DPDX] = free * sample(XF, F_DP, kx, ix, wx, interior)
+    s[S_DPDZ] = free * sample(ZF, F_DP, kz, iz, wz, interior)
+    s[S_DTDX] = sample(XF, F_DTAU, kx, ix, wx, interior)
+    s[S_DTDZ] = sample(ZF, F_DTAU, kz, iz, wz, interior)
+    s[S_THETA] = sample(C, THETA, kc, ic, wc, interior)
+    s[S_MEAN_U] = sample(C, MEAN_U, kc, ic, wc, interior)
+    s[S_MEAN_V] = sample(C, MEAN_V, kc, ic, wc, interior)
+    s[S_DAMPING] = sample(C, DAMPING, kc, ic, wc, interior)
+    s[S_WIDTH] = own
+    return s
 
 
 @ti.func
@@ -206,19 +221,12 @@ def on_bed(sx: ti.f64, sz: ti.f64, radius: ti.f64, dz: ti.f64, C: ti.template(),
 def deposited(sx: ti.f64, sz: ti.f64, fluid_u: ti.f64, width: ti.f64, radius: ti.f64, rho_p: ti.f64,
               C: ti.template(), dense: ti.f64, rho_f: ti.f64, mu: ti.f64, gravity: ti.f64,
               wall_law: ti.i32) -> ti.i32:
-    """For a parcel on a bed (on_bed): its own cell is loose (theta_p < dense) and the Shields number of the bed
-    shear stress f_t sqrt(12) mu |u_f| / w is below Soulsby & Whitehouse's (1997) critical one
-    (particle_ops_numpy._deposited; closures.bed_shear_stress, critical_shields_number)."""
+    """For a parcel on a bed (on_bed): its own cell is loose (theta_p < dense) and the grain is below the
+    threshold of motion (closures.bed.held; particle_ops_numpy._deposited)."""
     out = 0
     k, i = owner(sx, sz)
     if C[THETA, k, i] < dense:
-        speed = ti.abs(fluid_u)
-        tau = wall_friction_factor(speed, width, mu, rho_f, wall_law) * ti.sqrt(12.0) * mu * speed / width
-        d = 2.0 * radius
-        shields = tau / ((rho_p - rho_f) * gravity * d)
-        d_star = d * ti.pow((rho_p / rho_f - 1.0) * gravity / (mu / rho_f) ** 2, 1.0 / 3.0)
-        critical = 0.30 / (1.0 + 1.2 * d_star) + 0.055 * (1.0 - ti.exp(-0.020 * d_star))
-        out = ti.cast(shields < critical, ti.i32)
+        out = bed.held(fluid_u, width, 2.0 * radius, rho_p, rho_f, mu, gravity, wall_law)
     return out
 
 
@@ -286,8 +294,9 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, P: ti.template(), s: ti.template(), dt
 def move(p: ti.i32, sx: ti.f64, sz: ti.f64, flag: ti.i32, P: ti.template(), dt: ti.f64, C: ti.template(),
          PR: ti.template()):
     """Eq. 44 for parcel p at cell coordinates (sx, sz) with its new velocity, x first, then z; a move that
-    blocked() stops is cancelled and that velocity component set to 0 (particle_ops_numpy.push). A parcel of
-    a QUIET cell (``flag``, stencil_flags) that stays in it is not stopped and skips the checks."""
+    blocked() (closures.walls) stops is cancelled and that velocity component set to 0 (particle_ops_numpy.push,
+    walls.blocked_numpy). A parcel of a QUIET cell (``flag``, stencil_flags) that stays in it is not stopped and
+    skips the checks."""
     theta_cp = PR[P_THETA_CP]
     dense = PR[P_FRICTION_FRACTION]
     gap = PR[P_BRIDGING] * 2.0 * P[RADIUS, p]
@@ -321,10 +330,9 @@ def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(),
     dense = PR[P_FRICTION_FRACTION]
     if not flag & LOOSE:
         if on_bed(sx, sz, P[RADIUS, p], PR[P_DZ], C, dense) > 0.0:
-            inv_den = 1.0 / (1.0 + dt * (W[DRAG, p] + 0.5 * W[S_DAMPING, p]))
-            friction = dt * PR[P_BED_FRICTION] * ti.abs((1.0 - rho_f * (1.0 / P[DENSITY, p])) * gravity) * inv_den
-            speed = ti.max(ti.abs(P[U, p]) - friction, 0.0)
-            P[U, p] = -speed if P[U, p] < 0.0 else speed
+            den = 1.0 + dt * (W[DRAG, p] + 0.5 * W[S_DAMPING, p])
+            P[U, p] = bed.bed_friction(P[U, p], (1.0 - rho_f / P[DENSITY, p]) * gravity, dt, den,
+                                       PR[P_BED_FRICTION])
             if PR[P_SHIELDS] > 0.0:
                 if deposited(sx, sz, W[S_UF, p], W[S_WIDTH, p], P[RADIUS, p], P[DENSITY, p], C, dense, rho_f,
                              PR[P_MU], gravity, ti.cast(PR[P_WALL_LAW], ti.i32)):

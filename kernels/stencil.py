@@ -1,12 +1,14 @@
 """Taichi functions shared by the particle passes: bilinear stencils (Eq. 36-37), per-cell fast-path flags,
-the wall and packing rules of a parcel's move, and the run-local deposit into grid copies.
+and the run-local deposit into grid copies. The wall and packing rules of a parcel's move are the walls family
+of the closures (hfgpu.kernels.closures.walls).
 
 Grids are the engine's channelled arrays (kernels.layout): ``G[channel, k, i]``; a parcel's position enters
-as cell coordinates s = (x - x0) / dx (the expression of hfgpu.proppant.interpolation.weights).
-The NumPy references are in hfgpu.proppant.interpolation and hfgpu.proppant.particle_ops_numpy.
+as cell coordinates s = (x - x0) / dx (the expression of hfgpu.kernels.stencil_numpy.weights).
+The NumPy references are in hfgpu.kernels.stencil_numpy, hfgpu.proppant.interpolation and
+hfgpu.proppant.particle_ops_numpy.
 """
 
-from hfgpu.kernels.layout import CELL, P_FRICTION_FRACTION, THETA, WIDTH
+from hfgpu.kernels.layout import P_FRICTION_FRACTION, THETA, WIDTH
 from hfgpu.kernels.runtime import ti
 
 CHUNK = 64  # parcels per block of the atomic (GPU) deposits
@@ -74,8 +76,8 @@ def sample(grid: ti.template(), channel: ti.template(), k0: ti.i32, i0: ti.i32, 
 def cell_flags(k: ti.i32, i: ti.i32, cells: ti.template(), theta_cp: ti.f64, dense: ti.f64) -> ti.i32:
     """stencil_flags of cell (k, i): INTERIOR, QUIET and LOOSE (see the constants; the last two only with
     INTERIOR). A parcel owned by an INTERIOR cell has all its stencil nodes active (bilinear's plain weights);
-    one owned by a QUIET cell that stays in it is not stopped by any rule of blocked(); one owned by a LOOSE
-    cell is not on a bed (on_bed)."""
+    one owned by a QUIET cell that stays in it is not stopped by any rule of closures.walls.blocked; one owned
+    by a LOOSE cell is not on a bed (on_bed)."""
     nz = cells.shape[1]
     nx = cells.shape[2]
     f = 0
@@ -146,82 +148,6 @@ def closed(k: ti.i32, i: ti.i32, cells: ti.template()) -> ti.i32:
     out = 1
     if k >= 0 and k < cells.shape[1] and i >= 0 and i < cells.shape[2]:
         out = ti.cast(cells[WIDTH, k, i] <= 0.0, ti.i32)
-    return out
-
-
-@ti.func
-def blocked(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.template(), theta_cp: ti.f64,
-            dense: ti.f64, gap: ti.f64) -> ti.i32:
-    """The move (sx, sz) -> (sxn, szn) (cell coordinates) leaves the grid, enters a closed cell, enters another
-    cell narrower than ``gap`` (the parcel's bridging width, bridging_factor x 2 r), raises the parcel's bilinear
-    weight on a cell with theta_p >= theta_cp, or heads for a wall from a cell with theta_p >= dense
-    (friction_volume_fraction; particle_ops_numpy._blocked)."""
-    out = 1
-    width = owner_width(sxn, szn, cells)
-    if width > 0.0:
-        out = 0
-        if width < gap:
-            k0, i0 = owner(sx, sz)
-            k1, i1 = owner(sxn, szn)
-            if k0 != k1 or i0 != i1:
-                out = 1
-        if out == 0 and packed_near(sxn, szn, cells, theta_cp):
-            out = packed_gain(sx, sz, sxn, szn, cells, theta_cp)
-        if out == 0:
-            out = toward_wall_dense(sx, sz, sxn, szn, cells, dense)
-    return out
-
-
-@ti.func
-def toward_wall_dense(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.template(),
-                      dense: ti.f64) -> ti.i32:
-    """The parcel's own cell has theta_p >= dense and it moves, within the half cell next to a wall (domain
-    edge or closed cell), towards that wall (particle_ops_numpy._toward_wall_dense). The sign of the move is
-    that of sxn - sx: cell coordinates are monotone in x, and differ wherever the move counts."""
-    out = 0
-    k, i = owner(sx, sz)
-    if k >= 0 and k < cells.shape[1] and i >= 0 and i < cells.shape[2]:
-        if cells[THETA, k, i] >= dense:
-            fx = sx - i
-            fz = sz - k
-            if ti.abs(sxn - i) > ti.abs(fx) and fx * (sxn - sx) > 0.0:
-                out = closed(k, i + (1 if fx >= 0.0 else -1), cells)
-            if ti.abs(szn - k) > ti.abs(fz) and fz * (szn - sz) > 0.0:
-                out = out | closed(k + (1 if fz >= 0.0 else -1), i, cells)
-    return out
-
-
-@ti.func
-def packed_near(sx: ti.f64, sz: ti.f64, cells: ti.template(), theta_cp: ti.f64) -> ti.i32:
-    """Whether a cell of the 2 x 2 cell stencil of (sx, sz) has theta_p >= theta_cp (fast path of blocked)."""
-    i0 = ti.cast(ti.floor(sx), ti.i32)
-    k0 = ti.cast(ti.floor(sz), ti.i32)
-    found = 0
-    for a in ti.static(range(2)):
-        for b in ti.static(range(2)):
-            if k0 + a >= 0 and k0 + a < cells.shape[1] and i0 + b >= 0 and i0 + b < cells.shape[2]:
-                if cells[THETA, k0 + a, i0 + b] >= theta_cp:
-                    found = 1
-    return found
-
-
-@ti.func
-def packed_gain(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.template(), theta_cp: ti.f64) -> ti.i32:
-    """Whether the move raises the parcel's bilinear weight on a cell with theta_p >= theta_cp."""
-    out = 0
-    k0, i0, w0 = bilinear(sx, sz, cells, CELL, False)
-    k1, i1, w1 = bilinear(sxn, szn, cells, CELL, False)
-    for a in ti.static(range(2)):
-        for b in ti.static(range(2)):
-            if w1[2 * a + b] > 0.0:
-                if cells[THETA, k1 + a, i1 + b] >= theta_cp:
-                    before = 0.0
-                    for c in ti.static(range(2)):
-                        for d in ti.static(range(2)):
-                            if k0 + c == k1 + a and i0 + d == i1 + b:
-                                before += w0[2 * c + d]
-                    if w1[2 * a + b] > before:
-                        out = 1
     return out
 
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from hfgpu import open_results, run
-from hfgpu.proppant.interpolation import owning_cell
+from hfgpu.kernels.stencil_numpy import owning_cell
 from hfgpu.proppant.particle_ops_numpy import on_bed
 from hfgpu.propped import shields_ratio
 

@@ -112,7 +112,7 @@ def test_no_import_cycles(graph):
 
 def test_kernels_import_no_other_hfgpu_package(graph):
     """kernels/ is the bottom layer: hfgpu.proppant drives the kernels, never the reverse, so no cycle runs
-    through the two folders (the constants both sides read live in kernels/, e.g. kernels/wall_friction.py)."""
+    through the two folders (the constants both sides read live in kernels/, e.g. kernels/closures/wall_friction.py)."""
     outside = {(module, target) for module, targets in graph.items() if module.startswith("hfgpu.kernels")
                for target in targets if not target.startswith("hfgpu.kernels")}
     assert not outside, f"kernels/ imports hfgpu modules outside it: {sorted(outside)}"

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hfgpu.io.results import ResultsWriter
 from types import SimpleNamespace
 
-from hfgpu.proppant import closures
+from hfgpu.io.results import ResultsWriter
+from hfgpu.kernels.closures import bed
 from hfgpu.proppant.params import MppicParams
 from hfgpu.propped import (area_history, areal_solid, created_area, fracture_area_history, packed_fraction,
                            packed_history, parcel_groups, propped_cells, propped_summary)
@@ -73,7 +73,7 @@ def test_parcel_groups_sort_parcels_by_the_bed_rule_and_the_threshold_of_motion(
     setup = SimpleNamespace(params=MppicParams(), numerics=SimpleNamespace(gravity=9.81),
                             classes=(SimpleNamespace(name="sand"),))
     # the critical speed of these grains in water over a 5 mm gap lies between the two rows' speeds
-    u_cr = closures.critical_shields_number(D, 2650.0, 1000.0, 1e-3, 9.81) * 1650.0 * 9.81 * D * 5e-3 \
+    u_cr = bed.critical_shields_number_numpy(D, 2650.0, 1000.0, 1e-3, 9.81) * 1650.0 * 9.81 * D * 5e-3 \
         / (np.sqrt(12.0) * 1e-3)
     assert 0.1 < u_cr < 1.0
     g = parcel_groups(snap, setup, 1000.0, 1e-3)["sand"]

@@ -250,19 +250,16 @@ def as_f64(a: np.ndarray) -> np.ndarray:
 
 
 def param_vector(params: MppicParams, grid: StaggeredGrid, rho_f: float, mu_f: float, gravity: float) -> np.ndarray:
-    """The run constants in the order of kernels.layout (PR)."""
+    """The run constants PR, slot by slot by their names in kernels.layout PARAMS: an attribute of ``params``
+    (MppicParams) by its name, else the run's value of that name (the grid frame's x0, z0, dx, dz; rho_f, mu_f,
+    gravity); ValueError for a name that is neither (or both)."""
     frame = grid.frame
+    run = {"x0": frame.x0, "z0": frame.z0, "dx": frame.dx, "dz": frame.dz, "rho_f": rho_f, "mu_f": mu_f,
+           "gravity": gravity}
     out = np.zeros(L.PARAM_COUNT)
-    values = {
-        L.P_X0: frame.x0, L.P_Z0: frame.z0, L.P_DX: frame.dx, L.P_DZ: frame.dz, L.P_THETA_CP: params.theta_cp,
-        L.P_EPSILON: params.epsilon, L.P_PACKING_RESTITUTION: params.packing_restitution,
-        L.P_DRAG_LAW: params.drag_law_code, L.P_RE_COEFFICIENT: params.drag_re_coefficient,
-        L.P_BRIDGING: params.bridging_factor, L.P_DRAG_ITERATIONS: params.drag_iterations,
-        L.P_BED_FRICTION: params.bed_friction, L.P_FRICTION_FRACTION: params.friction_volume_fraction,
-        L.P_SHIELDS: float(params.shields_deposition), L.P_WALL_LAW: params.wall_friction_code,
-        L.P_RHO_F: rho_f, L.P_MU: mu_f, L.P_GRAVITY: gravity, L.P_STRESS_P: params.P_s,
-        L.P_STRESS_BETA: params.beta, L.P_RESTITUTION: params.restitution, L.P_DAMPING: float(params.damping),
-        L.P_DAMPING_THRESHOLD: params.damping_threshold}
-    for slot, value in values.items():
-        out[slot] = value
+    for slot, name in enumerate(L.PARAMS):
+        if (name in run) == hasattr(params, name):
+            raise ValueError(f"param_vector: PARAMS name {name!r} is {'both' if name in run else 'neither'} an "
+                             f"attribute of MppicParams {'and' if name in run else 'nor'} a run value {sorted(run)}")
+        out[slot] = float(run[name] if name in run else getattr(params, name))
     return out

@@ -25,7 +25,8 @@ import numpy as np
 from ..errors import SceneError
 from ..records import GridFrame
 from .config import Port, ProppantClass
-from .interpolation import deposit_masks, weights
+from ..kernels.stencil_numpy import weights
+from .interpolation import deposit_masks
 
 PARCEL_KEYS = ("x", "z", "u", "v", "radius", "density", "particles", "state", "class_id")
 #: Random positions in its inlet a parcel is tried at before it is held back (screen-out).

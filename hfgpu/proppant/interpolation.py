@@ -10,16 +10,14 @@ open cells (width > 0); faces strictly inside the grid with an open cell on both
 faces of closed cells carry boundary conditions only: no fluid momentum is solved there, so no force is
 deposited there and no gradient is defined there). A parcel whose 4 nodes are all inactive gets all-zero
 weights (it deposits and reads nothing); a parcel in an open cell always has an active cell node (its own).
+
+The weights and the owning cell of a point are hfgpu.kernels.stencil_numpy's (weights, owning_cell); here are
+the node masks they take and the sums over them.
 """
 
 from __future__ import annotations
 
 import numpy as np
-
-from ..records import GridFrame
-
-#: offset of node [0, 0] from the centre of cell [0, 0], in cells (x, z)
-OFFSETS = {"cell": (0.0, 0.0), "xface": (-0.5, 0.0), "zface": (0.0, -0.5)}
 
 
 def active_nodes(width: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -45,50 +43,13 @@ def face_widths(width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def deposit_masks(width: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Node weights of the deposits (Eq. 38-39) on (cell, xface, zface): each active node's width, 0 elsewhere.
-    Passed to :func:`weights` as its ``mask``, they give I_k w_k / sum_j I_j w_j, so that a parcel's share of
-    node k divided by the node's volume dx dz w_k is V I_k / (dx dz sum_j I_j w_j), its bilinear share over the
-    mean width of its stencil: a narrow cell beside a loaded wide one (a fracture's tip, a cell that just
-    opened) gets a share like its neighbours', not w_wide / w_k times theirs. On a uniform width these are the
-    plain bilinear weights of :func:`active_nodes`'s masks."""
+    Passed to hfgpu.kernels.stencil_numpy.weights as its ``mask``, they give I_k w_k / sum_j I_j w_j, so that a
+    parcel's share of node k divided by the node's volume dx dz w_k is V I_k / (dx dz sum_j I_j w_j), its
+    bilinear share over the mean width of its stencil: a narrow cell beside a loaded wide one (a fracture's tip,
+    a cell that just opened) gets a share like its neighbours', not w_wide / w_k times theirs. On a uniform
+    width these are the plain bilinear weights of :func:`active_nodes`'s masks."""
     xface, zface = face_widths(width)
     return np.where(width > 0.0, width, 0.0), xface, zface
-
-
-def owning_cell(x, z, frame: GridFrame, shape: tuple[int, int]):
-    """(k, i, inside) of the cell containing each point; k, i are clipped into the grid."""
-    nz, nx = shape
-    i = np.floor((x - frame.x0) / frame.dx + 0.5).astype(np.int64)
-    k = np.floor((z - frame.z0) / frame.dz + 0.5).astype(np.int64)
-    inside = (i >= 0) & (i < nx) & (k >= 0) & (k < nz)
-    return np.clip(k, 0, nz - 1), np.clip(i, 0, nx - 1), inside
-
-
-def weights(x, z, frame: GridFrame, location: str, mask: np.ndarray):
-    """Renormalised bilinear weights (Eq. 36-37) of points (x, z) onto the active nodes of ``location``.
-
-    Returns (k, i, w), each (N, 4): node rows/columns (clipped into the grid) and weights summing to 1 per
-    point, or to 0 where no node of the 2 x 2 stencil is active. ``mask`` is the node activity array.
-    """
-    ox, oz = OFFSETS[location]
-    nz, nx = mask.shape
-    sx = (np.asarray(x) - frame.x0) / frame.dx - ox
-    sz = (np.asarray(z) - frame.z0) / frame.dz - oz
-    i0 = np.floor(sx)
-    k0 = np.floor(sz)
-    fx = sx - i0
-    fz = sz - k0
-    i0 = i0.astype(np.int64)
-    k0 = k0.astype(np.int64)
-    kk = np.stack([k0, k0, k0 + 1, k0 + 1], axis=1)
-    ii = np.stack([i0, i0 + 1, i0, i0 + 1], axis=1)
-    w = np.stack([(1 - fz) * (1 - fx), (1 - fz) * fx, fz * (1 - fx), fz * fx], axis=1)
-    inside = (kk >= 0) & (kk < nz) & (ii >= 0) & (ii < nx)
-    kk = np.clip(kk, 0, nz - 1)
-    ii = np.clip(ii, 0, nx - 1)
-    w = np.where(inside, w * mask[kk, ii], 0.0)
-    total = w.sum(axis=1, keepdims=True)
-    w = np.divide(w, total, out=np.zeros_like(w), where=total > 0.0)
-    return kk, ii, w
 
 
 def interpolate(field: np.ndarray, k, i, w) -> np.ndarray:

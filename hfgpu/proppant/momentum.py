@@ -13,14 +13,9 @@ velocities (Eq. 50-57). The predicted velocity solves Eq. 49 with the wall frict
                + dt w_P ( (p_W - p_E)/(rho_f dx) - F_x/rho_f ),
     a_P = (theta_f w)_P + dt/(dx dz) sum_faces c_P + dt 12 mu_f,P f_t,P / (rho_f w_P).
 
-f_t (:func:`wall_friction_factor`) is 1 for the laminar friction of Eq. 9 (wall_friction = "laminar"); for
-"dean" it carries the friction past the laminar-turbulent transition of the flow between the fracture faces:
-Dean's (1978, J. Fluids Eng. 100, 215) skin friction of smooth plane-channel flow, c_f = tau_w / (rho_f U^2/2)
-= 0.073 Re^(-1/4) with Re = rho_f |U| w / mu_f (bulk velocity, full gap), gives the gap-averaged friction per
-unit volume 2 tau_w / w = c_f rho_f |U| U / w; the laminar c_f = 12/Re gives Eq. 9, so the two laws are Eq. 9
-times f_t = max(1, c_f Re / 12) = max(1, (0.073/12) Re^(3/4)) (they cross at Re = (12/0.073)^(4/3) = 899).
-|U| = (u^2 + v^2)^(1/2) is the old speed at the face (v on an x-face: the mean of its four v-faces), so f_t is
-lagged and the friction stays point-implicit.
+f_t is the wall-friction factor of ``wall_friction`` (hfgpu.kernels.closures.wall_friction: 1 for "laminar",
+Dean's turbulent friction for "dean"), from the old speed |U| = (u^2 + v^2)^(1/2) at the face (v on an x-face:
+the mean of its four v-faces), so f_t is lagged and the friction stays point-implicit.
 
 Two terms are taken at the new level, point-implicitly (no linear system): the friction, and the u_P
 coefficients c_P of the fluxes. Why: explicitly the friction limits the step to dt < rho_f w^2/(12 mu_f)
@@ -44,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kernels.wall_friction import DEAN_COEFFICIENT, wall_friction_code
+from ..kernels.closures.wall_friction import wall_friction_code, wall_friction_factor_numpy
 from .grid import face_mean
 
 
@@ -56,15 +51,6 @@ def face_coefficients(conductance: np.ndarray, mass_flux: np.ndarray) -> tuple[n
     a = np.maximum(0.0, 1.0 - 0.1 * np.abs(mass_flux) / safe) ** 5
     da = np.where(conductance > 0.0, conductance * a, 0.0)
     return da + np.maximum(mass_flux, 0.0), da + np.maximum(-mass_flux, 0.0)
-
-
-def wall_friction_factor(speed: np.ndarray, width: np.ndarray, mu: np.ndarray, rho: float,
-                         law: str) -> np.ndarray:
-    """f_t, the wall friction over the laminar 12 mu |U| / w^2 of Eq. 9 (module docstring): 1 for "laminar";
-    max(1, (0.073/12) Re^(3/4)), Re = rho |U| w / mu, for "dean" (Dean 1978, c_f = 0.073 Re^(-1/4))."""
-    if wall_friction_code(law) == 0:
-        return np.ones(np.broadcast(speed, width, mu).shape)
-    return np.maximum(1.0, DEAN_COEFFICIENT / 12.0 * (rho * speed * width / mu) ** 0.75)
 
 
 def _predict_x(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, rho, dx, dz, dt, wall_friction):
@@ -99,7 +85,8 @@ def _predict_x(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, rho, dx
         nb[1:] += cl_z * u_in[:-1]
         nb[:-1] += cr_z * u_in[1:]
     v_f = 0.25 * (v0[:-1, :-1] + v0[:-1, 1:] + v0[1:, :-1] + v0[1:, 1:])  # v at the x-faces
-    f_t = wall_friction_factor(np.sqrt(u0[:, 1:-1] ** 2 + v_f ** 2), w_f, mu_f, rho, wall_friction)
+    f_t = wall_friction_factor_numpy(np.sqrt(u0[:, 1:-1] ** 2 + v_f ** 2), w_f, mu_f, rho,
+                                     wall_friction_code(wall_friction))
     a = q_f + dt / (dx * dz) * diag + dt * 12.0 * mu_f * f_t / (rho * w_f)
     drive = w_f * (-(p[:, 1:] - p[:, :-1]) / (rho * dx) - force_x[:, 1:-1] / rho)
     rhs = q0_f * u0[:, 1:-1] + dt / (dx * dz) * nb + dt * drive

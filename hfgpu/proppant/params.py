@@ -6,9 +6,8 @@ from dataclasses import dataclass
 
 from ..errors import SceneError
 from ..kernels.closures.drag import DRAG_LAWS
-from ..kernels.wall_friction import WALL_FRICTION_LAWS, wall_friction_code
-
-VISCOSITY_LAWS = ("power", "krieger-dougherty")
+from ..kernels.closures.slurry_viscosity import VISCOSITY_LAWS
+from ..kernels.closures.wall_friction import WALL_FRICTION_LAWS, wall_friction_code
 
 
 @dataclass(frozen=True)
@@ -41,7 +40,7 @@ class MppicParams:
     relative velocity. Default 0 (inelastic): a bed whose stress carries its weight is then exactly at rest.
     damping: collision damping on/off; active only where theta_p > damping_threshold x theta_cp.
     bed_friction: Coulomb friction coefficient mu_b of a parcel resting in or on a dense bed (push,
-    particle_ops_numpy._bed_friction): its velocity along the bed (x, normal to gravity) loses at most
+    hfgpu.kernels.closures.bed): its velocity along the bed (x, normal to gravity) loses at most
     dt mu_b |1 - rho_f/rho_p| g per step (the friction its own submerged weight can mobilise), so a resting grain
     stays put until the tangential drag exceeds mu_b x its submerged weight (static friction), and a sliding
     one is slowed. Default tan(28.5 deg) = 0.543, the angle of internal friction of Johnson & Jackson (1987,
@@ -51,7 +50,7 @@ class MppicParams:
     cell or the grid edge below it); default 0.5, the onset of frictional stress of Johnson & Jackson (1987)
     (MFIX EPS_F_MIN = 0.5). Suspended parcels in a dilute suspension never feel it. The same contact network
     stops a parcel in the half cell next to a wall from moving towards that wall where its own cell has theta_p
-    >= this (push, particle_ops_numpy._toward_wall_dense: a move there changes no grid field).
+    >= this (push, closures.walls.toward_wall_dense_numpy: a move there changes no grid field).
     wall_friction: the fluid's friction on the fracture faces: "laminar" = Eq. 9, 12 mu_f u/(rho_f w^2);
     "dean" = Eq. 9 times max(1, (0.073/12) Re^(3/4)), Re = rho_f |u| w / mu_f, Dean's (1978) turbulent skin
     friction of smooth plane-channel flow, c_f = 0.073 Re^(-1/4), past the crossing of the two laws at

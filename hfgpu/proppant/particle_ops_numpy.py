@@ -11,17 +11,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kernels.closures import bed
 from ..kernels.closures.particle_stress import packing_limiter_numpy
-from ..kernels.layout import BRIDGED, SUSPENDED
+from ..kernels.closures.walls import blocked_numpy
+from ..kernels.layout import (BRIDGED, M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME,
+                              MOMENT_COUNT, MOMENT_FIELDS, SEEN_FIELDS, SUSPENDED)
+from ..kernels.stencil_numpy import owning_cell, weights
 from ..records import GridFrame
 from . import closures
 from .grid import face_mean
-from .interpolation import active_nodes, deposit, deposit_masks, interpolate, owning_cell, weights
+from .interpolation import active_nodes, deposit, deposit_masks, interpolate
 from .params import MppicParams
 from .parcels import Parcels
 
-#: channels of the scattered per-cell sums, in order
-MOMENT_CHANNELS = ("volume", "mass", "mass_u", "mass_v", "mass_speed2", "n_r3", "n_r2")
+#: channels of the scattered per-cell sums, in order: kernels/layout.py MOMENT_FIELDS (M_VOLUME, ...)
+MOMENT_CHANNELS = MOMENT_FIELDS
 
 
 @dataclass(frozen=True)
@@ -71,17 +75,9 @@ class ParcelFluid:
     gradient (Eq. 41) and particle-stress gradient [Pa/m] (face gradients, same weights), theta_p, mean parcel
     velocity and collision damping rate 1/tau_D (cell weights), and the width of the parcel's own cell [m]."""
 
-    fluid_u: np.ndarray
-    fluid_v: np.ndarray
-    dpdx: np.ndarray
-    dpdz: np.ndarray
-    dtaudx: np.ndarray
-    dtaudz: np.ndarray
-    volume_fraction: np.ndarray
-    mean_u: np.ndarray
-    mean_v: np.ndarray
-    damping_rate: np.ndarray
-    width: np.ndarray
+    # the fields fluid_u, fluid_v, dpdx, dpdz, dtaudx, dtaudz, volume_fraction, mean_u, mean_v, damping_rate,
+    # width: kernels/layout.py SEEN_FIELDS, the SEEN rows of the Taichi engine's work array (S_UF, ...)
+    __annotations__ = {name: "np.ndarray" for name in SEEN_FIELDS}
 
 
 def check_width(width: np.ndarray) -> tuple[int, int]:
@@ -102,21 +98,28 @@ def check_fluid(width: np.ndarray, u: np.ndarray, v: np.ndarray, pressure: np.nd
 
 
 def moment_sums(parcels: Parcels, frame: GridFrame, width: np.ndarray) -> np.ndarray:
-    """Bilinear sums (7, nz, nx) of the MOMENT_CHANNELS over parcels (numerators of Eq. 38 and of the
-    mass averages of O'Rourke & Snider 2010)."""
+    """Bilinear sums (MOMENT_COUNT, nz, nx) of the MOMENT_CHANNELS over parcels (numerators of Eq. 38 and of the
+    mass averages of O'Rourke & Snider 2010), channel M_VOLUME, M_MASS, ... (kernels/layout.py) by name."""
     shape = check_width(width)
     cell_weight, _, _ = deposit_masks(width)
     k, i, w = weights(parcels.x, parcels.z, frame, "cell", cell_weight)
     vol = parcels.solid_volume()
     mass = vol * parcels.density
-    values = (vol, mass, mass * parcels.u, mass * parcels.v, mass * (parcels.u ** 2 + parcels.v ** 2),
-              parcels.particles * parcels.radius ** 3, parcels.particles * parcels.radius ** 2)
-    return np.stack([deposit(val, k, i, w, shape) for val in values])
+    values = {"volume": vol, "mass": mass, "mass_u": mass * parcels.u, "mass_v": mass * parcels.v,
+              "mass_speed2": mass * (parcels.u ** 2 + parcels.v ** 2),
+              "n_r3": parcels.particles * parcels.radius ** 3, "n_r2": parcels.particles * parcels.radius ** 2}
+    if set(values) != set(MOMENT_FIELDS):
+        raise RuntimeError(f"moment_sums: sums {sorted(values)} != MOMENT_FIELDS {sorted(MOMENT_FIELDS)}")
+    sums = np.empty((MOMENT_COUNT, *shape))
+    for name, val in values.items():
+        sums[MOMENT_FIELDS.index(name)] = deposit(val, k, i, w, shape)
+    return sums
 
 
 def finish_moments(sums: np.ndarray, frame: GridFrame, width: np.ndarray) -> CellMoments:
     """CellMoments from the channel sums: theta_p by Eq. 38 (V = dx dz w), mass averages and Sauter radius."""
-    vol, mass, mu, mv, ms2, nr3, nr2 = sums
+    vol, mass, mu, mv, ms2, nr3, nr2 = (sums[c] for c in (M_VOLUME, M_MASS, M_MASS_U, M_MASS_V, M_MASS_SPEED2,
+                                                          M_NR3, M_NR2))
     cell_volume = frame.dx * frame.dz * width
 
     def ratio(a, b):
@@ -206,75 +209,20 @@ def on_bed(x, z, radius, frame: GridFrame, width: np.ndarray, volume_fraction: n
     return inside & (dense | on_floor)
 
 
-def _bed_friction(u, on_bed, buoyant_g, dt, den, params: MppicParams):
-    """Coulomb friction along a bed (velocity component normal to gravity) in the implicit update of Eq. 43:
-    the friction force per unit mass mu_b |g'| (g' = (1 - rho_f/rho_p) g, the submerged weight) opposes the
-    motion and, being static friction, at most cancels it: u <- sign(u) max(|u| - dt mu_b |g'| / den, 0)."""
-    slide = np.maximum(np.abs(u) - dt * params.bed_friction * np.abs(buoyant_g) / den, 0.0)
-    return np.where(on_bed, np.copysign(slide, u), u)
-
-
 def _deposited(x, z, on_bed, seen: ParcelFluid, radius, rho_p, frame: GridFrame, fields: GridFields,
                params: MppicParams, fluid_density, fluid_viscosity, gravity) -> np.ndarray:
     """True where a parcel rests on a bed surface below the threshold of motion (shields_deposition): on a
     bed (on_bed) with its own cell loose (theta_p < friction_volume_fraction: a grain on the floor or on top
     of a dense cell, not inside the bed) and a Shields number of the bed shear stress of the fluid velocity
     along the bed it sees below the critical one, tau_b / ((rho_p - rho_f) g 2r) < theta_cr
-    (closures.bed_shear_stress, closures.critical_shields_number)."""
+    (hfgpu.kernels.closures.bed.held_numpy)."""
     if not params.shields_deposition:
         return np.zeros(x.shape, dtype=bool)
     k, i, _ = owning_cell(x, z, frame, fields.width.shape)
     surface = on_bed & (fields.volume_fraction[k, i] < params.friction_volume_fraction)
     width = np.where(surface, seen.width, 1.0)
-    tau = closures.bed_shear_stress(seen.fluid_u, width, fluid_density, fluid_viscosity, params.wall_friction)
-    with np.errstate(divide="ignore", invalid="ignore"):  # a neutrally buoyant grain: no threshold, never held
-        shields = closures.shields_number(tau, 2.0 * radius, rho_p, fluid_density, gravity)
-    return surface & (shields < closures.critical_shields_number(2.0 * radius, rho_p, fluid_density,
-                                                                 fluid_viscosity, gravity))
-
-
-def _blocked(x, z, x_try, z_try, frame: GridFrame, fields: GridFields, params: MppicParams,
-             radius: np.ndarray) -> np.ndarray:
-    """True where the move (x, z) -> (x_try, z_try) leaves the grid, enters a closed cell, enters another cell
-    narrower than the parcel's bridging width (width < bridging_factor x 2 r: the grain bridges at the mouth of
-    an aperture it cannot pass, so proppant never reaches the narrow tip region of a growing fracture; inside
-    such a cell a point parcel would put theta_p = V_s / (w dx dz) above close packing), raises the
-    bilinear weight (Eq. 37) of the parcel on a cell whose theta_p (Eq. 38, this step's scatter) is already
-    >= theta_cp (the packing cap of push), or heads for a wall from a dense cell (_toward_wall_dense)."""
-    k, i, inside = owning_cell(x_try, z_try, frame, fields.width.shape)
-    k_old, i_old, _ = owning_cell(x, z, frame, fields.width.shape)
-    narrow = ((k != k_old) | (i != i_old)) & (fields.width[k, i] < params.bridging_factor * 2.0 * radius)
-    k0, i0, w0 = weights(x, z, frame, "cell", fields.cell_mask)
-    k1, i1, w1 = weights(x_try, z_try, frame, "cell", fields.cell_mask)
-    same = (k1[:, :, None] == k0[:, None, :]) & (i1[:, :, None] == i0[:, None, :])
-    before = np.sum(w0[:, None, :] * same, axis=2)
-    packed = fields.volume_fraction[k1, i1] >= params.theta_cp
-    return ~inside | (fields.width[k, i] <= 0.0) | narrow | np.any(packed & (w1 > before), axis=1) \
-        | _toward_wall_dense(x, z, x_try, z_try, frame, fields, params)
-
-
-def _toward_wall_dense(x, z, x_try, z_try, frame: GridFrame, fields: GridFields, params: MppicParams):
-    """True where a parcel in the half cell next to a wall (domain edge or closed cell) moves towards it while
-    its own cell is dense, theta_p >= friction_volume_fraction (a contact network, as for bed friction). There
-    the bilinear weights of Eq. 37 no longer change (the wall's node is inactive), so the move changes no grid
-    field: neither the packing cap nor the particle stress (Eq. 16) can see or resist the grains piling up
-    against the wall, and the stress gradient the parcel reads is that of the face on its other side. In a
-    contact network the grains between the parcel and the wall (its mirror image, a cell as dense) carry it;
-    in a loose cell it settles through."""
-    nz, nx = fields.width.shape
-    k, i, inside = owning_cell(x, z, frame, (nz, nx))
-    dense = inside & (fields.volume_fraction[k, i] >= params.friction_volume_fraction)
-    out = np.zeros(x.shape, dtype=bool)
-    for pos, new, origin, step, along_x in ((x, x_try, frame.x0, frame.dx, True),
-                                            (z, z_try, frame.z0, frame.dz, False)):
-        f = (pos - origin) / step - (i if along_x else k)
-        moves_out = (np.abs((new - origin) / step - (i if along_x else k)) > np.abs(f)) & (f * (new - pos) > 0)
-        side = np.where(f >= 0.0, 1, -1)
-        kn, in_ = (k, i + side) if along_x else (k + side, i)
-        beyond = (kn < 0) | (kn >= nz) | (in_ < 0) | (in_ >= nx)
-        wall = beyond | (fields.width[np.clip(kn, 0, nz - 1), np.clip(in_, 0, nx - 1)] <= 0.0)
-        out |= dense & moves_out & wall
-    return out
+    return surface & bed.held_numpy(seen.fluid_u, width, 2.0 * radius, rho_p, fluid_density, fluid_viscosity,
+                                    gravity, params.wall_friction_code)
 
 
 def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFields, dt: float,
@@ -289,13 +237,13 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     Walls, per component (x first): a move that would leave the grid, enter a closed cell, enter another cell
     narrower than the parcel's bridging width (bridging_factor x 2 r), or raise the
     parcel's bilinear weight on a cell whose theta_p (this step's scatter) is already >= theta_cp, or approach a
-    wall within the half cell next to it when the parcel's own cell is dense (_toward_wall_dense),
+    wall within the half cell next to it when the parcel's own cell is dense (hfgpu.kernels.closures.walls),
     is cancelled and that velocity component set to 0 (inelastic stop). The last rule is our packing cap: Snider's limiter
     bounds the velocity relative to the cell's mean parcel velocity, which does not stop a stream of parcels
     that arrives together against a wall; the cap bounds every cell's theta_p by theta_cp plus one step's
     inflow, whatever the parcels' velocities.
     Bed friction: where the parcel rests in or on a dense bed or on the floor (on_bed) its x velocity is
-    reduced by Coulomb friction (_bed_friction, mu_b = bed_friction) before the walls; with
+    reduced by Coulomb friction (hfgpu.kernels.closures.bed, mu_b = bed_friction) before the walls; with
     shields_deposition, one on a bed surface below the threshold of motion (_deposited) stops along x.
     Bridging: where the width of the parcel's cell is below bridging_factor x 2 r the parcel is set to state 1
     with zero velocity and does not move; others get state 0. Gravity [m/s^2] acts along +z (depth).
@@ -318,18 +266,21 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     v_new = v_new + packing_limiter_numpy(scale * seen.dtaudz, seen.mean_v - v_new, seen.dtaudz,
                                           params.packing_restitution)
     resting = on_bed(parcels.x, parcels.z, parcels.radius, frame, fields.width, fields.volume_fraction, params)
-    u_new = _bed_friction(u_new, resting, buoyant_g, dt, den, params)
+    u_new = bed.bed_friction_numpy(u_new, resting, buoyant_g, dt, den, params.bed_friction)
     u_new = np.where(_deposited(parcels.x, parcels.z, resting, seen, parcels.radius, rho_p, frame, fields, params,
                                 fluid_density, fluid_viscosity, gravity), 0.0, u_new)
     bridged = seen.width < params.bridging_factor * 2.0 * parcels.radius
     u_new = np.where(bridged, 0.0, u_new)
     v_new = np.where(bridged, 0.0, v_new)
     x_try = parcels.x + dt * u_new
-    blocked = _blocked(parcels.x, parcels.z, x_try, parcels.z, frame, fields, params, parcels.radius)
+    gap = params.bridging_factor * 2.0 * parcels.radius
+    blocked = blocked_numpy(parcels.x, parcels.z, x_try, parcels.z, frame, fields.width, fields.cell_mask,
+                            fields.volume_fraction, params.theta_cp, params.friction_volume_fraction, gap)
     x_new = np.where(blocked, parcels.x, x_try)
     u_new = np.where(blocked, 0.0, u_new)
     z_try = parcels.z + dt * v_new
-    blocked = _blocked(x_new, parcels.z, x_new, z_try, frame, fields, params, parcels.radius)
+    blocked = blocked_numpy(x_new, parcels.z, x_new, z_try, frame, fields.width, fields.cell_mask,
+                            fields.volume_fraction, params.theta_cp, params.friction_volume_fraction, gap)
     z_new = np.where(blocked, parcels.z, z_try)
     v_new = np.where(blocked, 0.0, v_new)
     parcels.x[:] = x_new

@@ -6,11 +6,14 @@ NumPy reference must not start Taichi (a NumPy run never loads it, tests/proppan
 the first call from a kernel being compiled (Taichi inlines it as any ``@ti.func``: the object carries
 ``_is_taichi_function``); any other attribute (``ti.min``, ``ti.select``, ...) is Taichi's, looked up when a
 kernel is compiled. ``Deferred(module)`` is a module imported on first attribute access (e.g. the inline exp and
-log of hfgpu.kernels.elementary, which import Taichi).
+log of hfgpu.kernels.elementary, which import Taichi). A twin that needs Taichi annotations (``ti.template()``
+for an array argument, ``ti.f64``) writes them in a module with ``from __future__ import annotations``: they
+stay strings until the function is built, and are evaluated then.
 """
 
 import functools
 import importlib
+import inspect
 
 
 class Deferred:
@@ -39,7 +42,10 @@ class TaichiFunc:
         """Taichi's function object for the wrapped function (what ``ti.func`` keeps in ``.func``)."""
         from hfgpu.kernels.runtime import ti as taichi
 
-        return taichi.func(self.__wrapped__).func
+        fn = self.__wrapped__
+        if any(isinstance(note, str) for note in fn.__annotations__.values()):
+            fn.__annotations__ = inspect.get_annotations(fn, eval_str=True)
+        return taichi.func(fn).func
 
     def __call__(self, *args, **kwargs):
         return self.func(*args, **kwargs)

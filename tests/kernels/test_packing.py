@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from hfgpu.proppant import closures
-from hfgpu.proppant.interpolation import active_nodes, interpolate, weights
+from hfgpu.kernels.stencil_numpy import weights
+from hfgpu.proppant.interpolation import active_nodes, interpolate
 from hfgpu.proppant.params import MppicParams
 from hfgpu.proppant.parcels import Parcels
 from hfgpu.records import GridFrame
@@ -55,7 +56,7 @@ def test_settled_bed_does_not_overpack_and_stays_at_rest(backend_name):
 
 @pytest.mark.parametrize("backend_name", ["numpy", "taichi"])
 def test_bed_friction_holds_resting_grains_and_slows_sliding_ones(backend_name):
-    """Coulomb bed friction in the push (particle_ops_numpy._bed_friction): parcels at rest in a dense bottom
+    """Coulomb bed friction in the push (hfgpu.kernels.closures.bed): parcels at rest in a dense bottom
     row (theta_p = 0.55 >= friction_volume_fraction 0.5, uniform: parcels at cell centres) and light ones in
     the row above it (the cell below is dense) under a uniform fluid velocity U along the bed. From rest with
     one drag solve and no damping, Eq. 43 gives u = dt D U / (1 + dt D); friction removes

@@ -8,10 +8,11 @@ import pytest
 from scipy.optimize import brentq
 
 from hfgpu.kernels import layout as L
+from hfgpu.kernels.stencil_numpy import weights
 from hfgpu.proppant import closures
 from hfgpu.proppant import particle_ops_numpy as ref
 from hfgpu.proppant.engine import make_engine
-from hfgpu.proppant.interpolation import active_nodes, face_widths, interpolate, weights
+from hfgpu.proppant.interpolation import active_nodes, face_widths, interpolate
 from hfgpu.proppant.params import MppicParams
 from hfgpu.proppant.parcels import Parcels
 from hfgpu.records import GridFrame

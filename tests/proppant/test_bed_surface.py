@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hfgpu.proppant import closures
-from hfgpu.proppant.momentum import wall_friction_factor
+from hfgpu.kernels.closures import bed
+from hfgpu.kernels.closures.wall_friction import wall_friction_code, wall_friction_factor_numpy
 from hfgpu.proppant.params import MppicParams
 from hfgpu.proppant.parcels import Parcels
 from hfgpu.records import GridFrame
@@ -26,11 +26,11 @@ def test_critical_shields_number_of_sand_in_water():
     0.03 at its minimum around D* = 10-30 (the dip of the Shields diagram)."""
     d_star = 0.3e-3 * ((RHO_P / RHO_F - 1.0) * G / (MU / RHO_F) ** 2) ** (1.0 / 3.0)
     assert d_star == pytest.approx(7.43, abs=0.01)
-    assert closures.critical_shields_number(0.3e-3, RHO_P, RHO_F, MU, G) == pytest.approx(0.0378, abs=2e-4)
-    tiny, huge = closures.critical_shields_number(np.array([1e-8, 1.0]), RHO_P, RHO_F, MU, G)
+    assert bed.critical_shields_number_numpy(0.3e-3, RHO_P, RHO_F, MU, G) == pytest.approx(0.0378, abs=2e-4)
+    tiny, huge = bed.critical_shields_number_numpy(np.array([1e-8, 1.0]), RHO_P, RHO_F, MU, G)
     assert tiny == pytest.approx(0.30, rel=1e-3) and huge == pytest.approx(0.055, rel=1e-3)
     d = np.geomspace(0.1e-3, 10e-3, 200)
-    curve = closures.critical_shields_number(d, RHO_P, RHO_F, MU, G)
+    curve = bed.critical_shields_number_numpy(d, RHO_P, RHO_F, MU, G)
     assert 0.028 < curve.min() < 0.032
 
 
@@ -42,12 +42,14 @@ def test_bed_shear_stress_is_the_surface_stress_of_the_gap_averaged_flow(law):
     w = 7.62e-3
     speed = np.array([0.05, 0.2, 0.5])
     lam = np.sqrt(12.0) * MU * speed / w
-    tau = closures.bed_shear_stress(-speed, w, RHO_F, MU, law)
-    np.testing.assert_allclose(tau, lam * wall_friction_factor(speed, w, MU, RHO_F, law), rtol=1e-14)
+    tau = bed.bed_shear_stress_numpy(-speed, w, RHO_F, MU, wall_friction_code(law))
+    f_t = wall_friction_factor_numpy(speed, w, MU, RHO_F, wall_friction_code(law))
+    np.testing.assert_allclose(tau, lam * f_t, rtol=1e-14)
     y = np.linspace(0.0, 1e-6, 3)
     profile = 1.0 - np.exp(-np.sqrt(12.0) * y / w)  # per unit outer velocity
     slope = MU * np.gradient(profile, y)[0]
-    assert slope * 0.2 == pytest.approx(closures.bed_shear_stress(0.2, w, RHO_F, MU, "laminar"), rel=1e-3)
+    laminar = bed.bed_shear_stress_numpy(0.2, w, RHO_F, MU, wall_friction_code("laminar"))
+    assert slope * 0.2 == pytest.approx(laminar, rel=1e-3)
     if law == "dean":  # Re = 1000 x 0.5 x 7.62e-3 / 1e-3 = 3810: turbulent, 0.073/12 Re^0.75 = 2.92
         assert tau[2] / lam[2] == pytest.approx(0.073 / 12.0 * 3810.0 ** 0.75, rel=1e-12)
         assert tau[0] == lam[0]  # Re 381: laminar
@@ -79,9 +81,10 @@ def threshold_speed(law):
     """The fluid speed at which a 0.3 mm grain in the 7.62 mm gap is at the critical Shields number."""
     from scipy.optimize import brentq
 
-    critical = closures.critical_shields_number(0.3e-3, RHO_P, RHO_F, MU, G)
-    return brentq(lambda s: closures.shields_number(closures.bed_shear_stress(s, 7.62e-3, RHO_F, MU, law),
-                                                    0.3e-3, RHO_P, RHO_F, G) - critical, 1e-3, 2.0)
+    critical = bed.critical_shields_number_numpy(0.3e-3, RHO_P, RHO_F, MU, G)
+    code = wall_friction_code(law)
+    return brentq(lambda s: bed.shields_number_numpy(bed.bed_shear_stress_numpy(s, 7.62e-3, RHO_F, MU, code),
+                                                     0.3e-3, RHO_P, RHO_F, G) - critical, 1e-3, 2.0)
 
 
 @pytest.mark.parametrize("backend_name", ["numpy", "taichi"])

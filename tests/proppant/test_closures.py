@@ -112,3 +112,12 @@ def test_slurry_viscosity_cap():
     assert closures.slurry_viscosity(0.6, 1e-3, kd) == pytest.approx(0.05, rel=1e-12)
     with pytest.raises(Exception, match="mppic.max_relative_viscosity"):
         MppicParams(max_relative_viscosity=0.5)
+
+
+def test_slurry_viscosity_laws_are_named_once():
+    """Each law of MppicParams.viscosity_law is one of the family's names; another name is refused."""
+    from hfgpu.kernels.closures import slurry_viscosity
+
+    assert slurry_viscosity.VISCOSITY_LAWS == ("power", "krieger-dougherty")
+    with pytest.raises(ValueError, match="viscosity_law"):
+        slurry_viscosity.exponent("einstein", -1.82, 0.6)

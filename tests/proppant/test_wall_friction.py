@@ -13,9 +13,9 @@ import pytest
 
 from hfgpu import load_scene
 from hfgpu.errors import SceneError
+from hfgpu.kernels.closures.wall_friction import wall_friction_code, wall_friction_factor_numpy
 from hfgpu.proppant.fluid import FluidNumerics, FluidSolver
 from hfgpu.proppant.grid import StaggeredGrid
-from hfgpu.proppant.momentum import wall_friction_factor
 from hfgpu.proppant.params import MppicParams
 from hfgpu.proppant.simulator import ProppantSimulation
 
@@ -58,7 +58,7 @@ def test_dean_is_laminar_below_the_crossing():
     np.testing.assert_array_equal(dpdx, steady_gradient(100.0, "laminar")[1])
     crossing = (12.0 / 0.073) ** (4.0 / 3.0)
     speeds = np.array([0.999, 1.001]) * crossing * MU / (RHO * GAP)
-    factor = wall_friction_factor(speeds, GAP, MU, RHO, "dean")
+    factor = wall_friction_factor_numpy(speeds, GAP, MU, RHO, wall_friction_code("dean"))
     assert factor[0] == 1.0 and 1.0 < factor[1] < 1.001
 
 
@@ -74,4 +74,4 @@ def test_wall_friction_knob():
     with pytest.raises(SceneError, match="wall_friction"):
         load_scene(text.replace('wall_friction = "dean"', 'wall_friction = "turbulent"'))
     with pytest.raises(ValueError):
-        wall_friction_factor(np.ones(1), GAP, MU, RHO, "turbulent")
+        wall_friction_code("turbulent")
