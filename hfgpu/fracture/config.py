@@ -41,6 +41,9 @@ class FractureNumerics:
     ribbon_fit: with the sub-grid front, how a ribbon cell's width places the front: "two_term" (the tip
         asymptote times a linear correction fitted through the ribbon and its inner neighbour) or "asymptote"
         (the asymptote's inverse alone); tip_cells.py has the equation and the measurements.
+    closure_width_fraction: a cell whose width falls over a step below this fraction of the largest width the
+        fracture has had is closed (simulator.py, "Closure"): its walls meet (contact, width 0) and the film
+        left in it leaks off with it.
     leakoff_clock: a cell whose leak-off the positivity ramp held below Carter's demand continues from the
         exposure time its leaked volume corresponds to (leakoff.carter_demand), so time spent dry does not
         count as exposure; off: Carter's law from the opening time, whatever the cell leaked.
@@ -60,6 +63,7 @@ class FractureNumerics:
     partial_tip_cells: bool = True
     max_front_advance: float = 1.0
     leakoff_clock: bool = True
+    closure_width_fraction: float = 1e-3
     front_tracking: str = "cells"
     ribbon_fit: str = "two_term"
 
@@ -86,6 +90,8 @@ def parse_fracture_numerics(t: Table, preset: Preset = BALANCED) -> FractureNume
         partial_tip_cells=t.boolean("partial_tip_cells", d.partial_tip_cells),
         max_front_advance=t.number("max_front_advance", d.max_front_advance, minimum=0.1, maximum=10.0),
         leakoff_clock=t.boolean("leakoff_clock", d.leakoff_clock),
+        closure_width_fraction=t.number("closure_width_fraction", d.closure_width_fraction, minimum=0.0,
+                                        maximum=0.1, exclusive_minimum=True),
         front_tracking=t.choice("front_tracking", ("cells", "subgrid"), d.front_tracking),
         ribbon_fit=t.choice("ribbon_fit", RIBBON_FITS, d.ribbon_fit),
     )

@@ -19,7 +19,10 @@ from .mesh import Grid
 #: Attributes (numbers or arrays) of the engine a checkpoint carries besides the grid.
 STATE_ATTRIBUTES = ("t", "t0", "v_front", "t_front", "leaked_total", "steps", "newton_iterations", "retries",
                     "coarsenings", "max_balance_error", "v_tip", "rejected", "dt_failed", "factorisations",
-                    "gmres_iterations")
+                    "gmres_iterations", "w_peak", "t_closed")
+#: Defaults of attributes added after files were written that lack them (the peak width: the grid's widths).
+LATER_ATTRIBUTES = {"w_peak": lambda state: float(np.max(state["grid"]["fields"]["w"], initial=0.0)),
+                    "t_closed": lambda state: float("nan")}
 
 
 def engine_state(engine) -> dict:
@@ -34,7 +37,8 @@ def engine_state(engine) -> dict:
 def restore_engine(engine, state: dict) -> None:
     """Continue ``engine`` (built for the same scene) from an ``engine_state``: same fields, same systems."""
     for name in STATE_ATTRIBUTES:
-        setattr(engine, name, np.array(state[name]) if isinstance(state[name], np.ndarray) else state[name])
+        value = state[name] if name in state else LATER_ATTRIBUTES[name](state)
+        setattr(engine, name, np.array(value) if isinstance(value, np.ndarray) else value)
     s = state["grid"]
     engine.grid = Grid(s["dx"], s["dz"], s["x_inj"], s["z_inj"], int(s["ix0"]), int(s["iz0"]),
                        {name: np.array(array) for name, array in s["fields"].items()})

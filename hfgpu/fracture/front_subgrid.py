@@ -92,7 +92,8 @@ class SubgridFront:
                 engine.newton_retry(dt)
             engine.use_grid(start.copy())
             dt *= 0.5
-        engine.accept(res, dt, advance, start if keep_ends else None)
+        tips = ~(start["active"] & (start["fill"] >= 1.0))   # pinned in this step (front_iterations)
+        engine.accept(res, dt, advance, start if keep_ends else None, tips[engine.rows, engine.cols])
         engine.v_front, engine.t_front = engine.v_tip, engine.t
         g = engine.grid
         g["w_rate"][...] = np.where(g["active"] & start["active"], (g["w"] - start["w"]) / dt, 0.0)

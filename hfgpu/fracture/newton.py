@@ -98,6 +98,7 @@ class StepProblem:
     w_smooth: float = 0.0     # smoothing width of the conductance's positive part [m]
     pinned: np.ndarray | None = None   # prescribed widths (tip cells of the sub-grid front), NaN: unknown [m]
     wetted: np.ndarray | None = None   # wetted fraction of each cell's area that leaks (None: all of it)
+    w_floor: float = 0.0      # a width below which a cell is closed (the engine's closure width) [m]
 
 
 @dataclass
@@ -173,7 +174,7 @@ def residual(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.n
     """Eq. 29 residual F(x) with the widths and pressures of ``_split``, plus the conductances and the
     ramp."""
     w, p = _split(prob, elastic, x, closed)
-    t, *dt_dw = conductance(prob.faces, w, prob.w_smooth)
+    t, *dt_dw = conductance(prob.faces, w, prob.w_smooth, prob.w_floor)
     g, dg = leak_fraction(prob, w)
     f = (prob.area * (w - prob.w_old) + prob.area * prob.demand * g - prob.dt * net_inflow(prob.faces, t, p)
          - prob.source)
@@ -302,7 +303,7 @@ def _newton(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nd
             continue
         x = x + step * dx
         r = trial
-        limit = tolerance * max(np.linalg.norm(x), 1e-300)
+        limit = tolerance * max(np.linalg.norm(x), prob.w_floor * np.sqrt(x.size), 1e-300)
         if np.linalg.norm(dx) < limit:   # undamped update
             return x, True, it, precond
         if simplified_exit and step == 1.0 and np.linalg.norm(simplified) < limit:

@@ -22,6 +22,15 @@ with the properties at the injection point -- the slowest mechanism controls ear
 opening times follow that vertex's R ~ t^a (tau = t0 (r / R0)^(1/a)). The cells hold the volume injected by t0 less the Carter volume leaked since
 their opening times (at most 90 % of it), in the shape a uniform net pressure gives (C w = const).
 
+Closure. Carter leak-off drains a shut-in fracture; the positivity ramp (leakoff.available_fraction) keeps a
+draining cell's width above 0, so without a rule its walls would never meet. A cell whose width falls over a
+step below ``closure_width_fraction`` of the largest width the fracture has had (``w_peak``) is closed at the
+end of that step: width 0, the film left in it added to the leak-off (the fluid it holds is what Carter's law
+would take from it within the step; the balance stays exact), and from then on it is a contact cell
+(newton.solve_step): it leaks no more, counts no area (geometry.py), and opens again when the fluid pressure
+exceeds the stress that holds it shut (a second injection). ``t_closed`` is the time the last open cell closed
+(NaN while any cell is open); the summary reports it.
+
 Coarsening. With ``mesh.max_cells_across`` set, the grid is coarsened by ``mesh.coarsening_factor`` (coarsen.py:
 3x3 merges, or PyFrac's 2x remeshing by area overlap; both centre a coarse cell on the injection cell) after a
 step whose footprint spans more cells than that along x or z; volume is carried exactly, so the balance holds
@@ -65,7 +74,7 @@ from .interpolate import StepEnds
 from .leakoff import carter_demand, carter_volume
 from .lubrication import build_faces
 from .mesh import GROW, Grid, injection_cell_centre
-from .newton import Elasticity, StepProblem, solve_step, start_widths
+from .newton import Elasticity, NewtonWork, StepProblem, StepResult, solve_step, start_widths
 from .solver_choice import use_dense
 from .views import View, front_extents, geometry, snapshot
 
@@ -180,6 +189,8 @@ class _Engine:
         self.factorisations = self.gmres_iterations = 0
         self.v_tip = 0.0
         self.dt_failed = math.inf   # the last step whose Newton failed, released step by step (next_dt)
+        self.w_peak = float(g["w"].max())   # the largest width the fracture has had (closure)
+        self.t_closed = math.nan            # when the last open cell closed (NaN while any is open)
         self.max_balance_error = 0.0
         self.ends: StepEnds | None = None   # the last step's two ends, when asked for (step's keep_ends)
         g["fill"][act] = 1.0
@@ -241,8 +252,15 @@ class _Engine:
             demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt, filled)
         w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
         prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
-                           demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted)
+                           demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted,
+                           self.num.closure_width_fraction * self.w_peak)
         closed = g.shut(self.t)[sel] if pinned is None else None   # the last step's contact set
+        if closed is not None and source[self.inj] > 0.0:
+            closed[self.inj] = False   # the injected fluid opens the perforated cell of a closed fracture
+        if closed is not None and closed.all() and not source.any():   # a closed fracture: nothing moves
+            zero = np.zeros(w_old.size)
+            return StepResult(w=zero, p=g["p"][sel].copy(), leaked=zero, iterations=0, converged=True,
+                              residual=zero, work=NewtonWork())
         with blas_threads(self.ix.size):
             res = solve_step(prob, self.elastic, tolerance or self.num.newton_tolerance,
                              self.num.newton_max_iterations,
@@ -267,20 +285,34 @@ class _Engine:
                               time=self.t + dt, cell=(int(self.ix[worst]), int(self.iz[worst])),
                               residual=float(np.abs(res.residual[worst]) / self.area))
 
-    def accept(self, res, dt: float, advance: float, start: Grid | None) -> None:
-        """Store an accepted step's widths, pressures and leak-off, its front advance [m] and move the clock;
-        with ``start`` (the grid at the step's start) keep both ends in ``ends``."""
+    def accept(self, res, dt: float, advance: float, start: Grid | None, pinned: np.ndarray | None = None) -> None:
+        """Store an accepted step's widths, pressures and leak-off, its front advance [m] and move the clock,
+        closing the drained cells (module docstring, "Closure") other than those ``pinned`` (the sub-grid
+        front's tip cells, whose width the front sets); with ``start`` (the grid at the step's start) keep both
+        ends in ``ends``."""
         if not (np.all(np.isfinite(res.w)) and np.all(np.isfinite(res.p))):
             raise SimulationError("non-finite width or pressure", time=self.t + dt)
         g, sel = self.grid, (self.rows, self.cols)
         t_a, leaked_a = self.t, self.leaked_total
         self.t += dt
-        g["w"][sel] = res.w
+        w_old = g["w"][sel]
+        self.w_peak = max(self.w_peak, float(res.w.max()))
+        drained = (res.w > 0.0) & (res.w < self.num.closure_width_fraction * self.w_peak) \
+            & (g["opened"][sel] < t_a)   # a cell opened at the step's start has one step to fill
+        if pinned is not None:
+            drained &= ~pinned
+        w = np.where(drained, 0.0, res.w)
+        leaked = res.leaked + np.where(drained, res.w * self.area, 0.0)   # the film leaks off as the walls meet
+        g["w"][sel] = w
         g["p"][sel] = res.p
         self.distances = None
-        g["leak_rate"][sel] = res.leaked / (self.area * dt)
-        g["leaked"][sel] = g["leaked"][sel] + res.leaked / self.area
-        self.leaked_total += float(res.leaked.sum())
+        g["leak_rate"][sel] = leaked / (self.area * dt)
+        g["leaked"][sel] = g["leaked"][sel] + leaked / self.area
+        self.leaked_total += float(leaked.sum())
+        if np.any(w > 0.0):
+            self.t_closed = math.nan
+        elif math.isnan(self.t_closed):
+            self.t_closed = self.t
         self.v_tip = advance / dt
         self.dt_failed *= FAILED_STEP_RELEASE
         self.steps += 1
@@ -435,5 +467,6 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
                 rejected=eng.rejected, coarsenings=eng.coarsenings, dx=eng.dx, dz=eng.dz,
                 cells=int(eng.grid["active"].sum()), w_inlet=final.inlet_width,
                 p_inlet=final.injection_pressure, injected=final.injected, stored=final.stored,
-                leaked=final.leaked, max_balance_error=eng.max_balance_error, **front_extents(eng, eng.now()),
+                leaked=final.leaked, max_balance_error=eng.max_balance_error, closed_at=eng.t_closed,
+                **front_extents(eng, eng.now()),
                 **geometry(eng, eng.now()))

@@ -6,7 +6,10 @@ centre), then with proppant ``propped`` (0/1), ``propped_width``, ``conductivity
 (created width) and ``pressure`` (fluid pressure; both 0 in closed cells); ``<stem>_pressure.csv`` beside it: one
 row per snapshot (the fracture's, or the proppant grid's for a proppant-only run), columns ``time``,
 ``pressure_injection`` (the cell nearest the injection point, NaN when the scene names none), ``pressure_mean``
-and ``pressure_max`` (over the open cells). Each header names the unit, e.g. ``conductivity [md ft]``, in SI or
+and ``pressure_max`` (over the open cells), and for a run with a shut-in (at least 2 step records after the pumps
+stop, hfgpu.io.summary.falloff_of) ``G`` (Nolte's G-function of the snapshot's time, hfgpu.fracture.falloff; NaN
+while pumping) and ``G_dP/dG`` (the superposition derivative of the step history's BHTP, linear in G between
+its records; NaN where the history has none). Each header names the unit, e.g. ``conductivity [md ft]``, in SI or
 field units; a run that did not complete adds a first line ``# hfgpu: the run is not complete (status "...")``.
 """
 
@@ -51,11 +54,39 @@ def write_csv(results: Any, grid: Any, out: Path, system: str) -> list[Path]:
     np.savetxt(out, table, delimiter=",", header=first + _header(names, system), comments="", fmt="%.10g")
     pressure = out.with_name(out.stem + "_pressure.csv")
     history = pressure_history(results)
-    table = np.column_stack([history[0]] + [in_units("pressure", column, system) for column in history[1:]])
     unit = unit_label("pressure", system)
-    header = ",".join(["time [s]"] + [f"pressure_{n} [{unit}]" for n in ("injection", "mean", "max")])
-    np.savetxt(pressure, table.reshape(-1, 4), delimiter=",", header=first + header, comments="", fmt="%.10g")
+    columns = [history[0]] + [in_units("pressure", column, system) for column in history[1:]]
+    header = ["time [s]"] + [f"pressure_{n} [{unit}]" for n in ("injection", "mean", "max")]
+    shut_in = falloff_columns(results, history[0])
+    if shut_in is not None:
+        columns += [shut_in[0], in_units("pressure", shut_in[1], system)]
+        header += ["G [-]", f"G_dP/dG [{unit}]"]
+    table = np.column_stack(columns).reshape(-1, len(header))
+    np.savetxt(pressure, table, delimiter=",", header=first + ",".join(header), comments="", fmt="%.10g")
     return [out, pressure]
+
+
+def falloff_columns(results: Any, times: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(G, G dP/dG [Pa]) at ``times`` [s] for a run with a shut-in (hfgpu.io.summary.falloff_of), NaN while
+    pumping and, for G dP/dG, outside the step records after the stop; None without a shut-in."""
+    from ..errors import HfgpuError
+    from ..fracture.falloff import G_function
+    from .summary import falloff_of, pump_end
+
+    try:
+        stop = pump_end(results.scene)
+    except (HfgpuError, ImportError):
+        return None
+    analysis = falloff_of(results.fracture_balance, stop)
+    if analysis is None:
+        return None
+    times = np.asarray(times, dtype=np.float64)
+    after = times > stop
+    g = np.full(times.shape, np.nan)
+    g[after] = G_function((times[after] - stop) / stop, analysis.alpha)
+    derivative = np.full(times.shape, np.nan)
+    derivative[after] = np.interp(g[after], analysis.G, analysis.derivative, left=np.nan, right=np.nan)
+    return g, derivative
 
 
 def pressure_history(results: Any) -> tuple[np.ndarray, ...]:

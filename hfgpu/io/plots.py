@@ -3,13 +3,14 @@
 Depth z is drawn downward; maps use each snapshot's own grid frame (cell centres x0 + i dx, z0 + j dz). The
 time panels of one map share one colour scale; every map of a layered scene draws the layer boundaries
 (``[[rock.layers]]``, depth positive down); outlines and markers have legends.
-Fracture: width maps at a few times with the cross-section at x = x_injection, footprint outlines over
-time, area and efficiency vs time, volume balance. Proppant (last snapshot): volume fraction map, map of
-the mean parcel speed per cell, parcels coloured by radius, solid balance. Coupled runs (both physics) add
-the paper's Figs. 13-18: volume fraction and speed maps over time, fluid streamlines, |u_p| probability
-plots at 1260 / 1800 / 3600 s (nearest snapshots), fracture and propped area vs time. Runs with proppant add
-the propped width and conductivity after closure (hfgpu.closure). A proppant-only column (at most
-MAX_COLUMN_CELLS columns, taller than wide) adds its interface heights against time.
+Fracture: width maps at a few times with the cross-section at x = x_injection, footprint outlines over time, area
+and efficiency vs time, volume balance, and after a shut-in the fall-off on Nolte's G-function
+(hfgpu.fracture.falloff). Proppant (last snapshot): volume fraction map, map of the mean parcel speed per cell,
+parcels coloured by radius, solid balance. Coupled runs (both physics) add the paper's Figs. 13-18: volume
+fraction and speed maps over time, fluid streamlines, |u_p| probability plots at 1260 / 1800 / 3600 s (nearest
+snapshots), fracture and propped area vs time. Runs with proppant add the propped width and conductivity after
+closure (hfgpu.closure). A proppant-only column (at most MAX_COLUMN_CELLS columns, taller than wide) adds its
+interface heights against time.
 Every figure draws in the results' ``[output] units`` (:mod:`hfgpu.io.display_units`: SI as stored, widths in
 mm, pressures in MPa; or field: ft, in, psi, bbl, ft^3, ft^2, ft/s); times stay in s. Functions that take a results
 file read its units (``units=`` overrides them); those that take a snapshot draw SI unless given ``units``.
@@ -298,6 +299,57 @@ def pressure_history(results: Results, units: FigureUnits | None = None) -> Figu
     for axis, values in ((right.xaxis, t[positive]), (right.yaxis, net[positive])):
         _log_ticks(axis, values)
     right.set(xlabel="time [s]", ylabel=label, title="log-log while pumping (Nolte-Smith)")
+    return fig
+
+
+def falloff(results: Results):
+    """The fall-off of the results' step history after the pumps stop (hfgpu.io.summary.falloff_of), None for a
+    run without one (no shut-in record, or a scene that does not parse)."""
+    from .summary import falloff_of, pump_end
+
+    try:
+        stop = pump_end(results.scene)
+    except (HfgpuError, ImportError):
+        return None
+    return falloff_of(results.fracture_balance, stop)
+
+
+def fall_off(results: Results, units: FigureUnits | None = None, analysis: Any = None) -> Figure:
+    """The fall-off on Nolte's G-function (hfgpu.fracture.falloff, ``analysis`` or :func:`falloff`): BHTP and
+    the minimum stress at the injection depth (left axis) and the superposition derivative G dP/dG (right axis)
+    against G, in MPa or psi, with the straight line through the origin the closure pick is read on and the
+    closure marked (or "no closure picked" in the title)."""
+    a = falloff(results) if analysis is None else analysis
+    if a is None:
+        raise HfgpuError("the results hold no record after the pumps stop: no fall-off to plot")
+    u = _units(results, units)
+    unit = u.label("pressure")
+    fig = Figure(figsize=(8, 4.5), layout="constrained")
+    left = fig.subplots()
+    right = left.twinx()
+    left.plot(a.G, u("pressure", a.pressure), "o-", ms=2, color="C0", label="BHTP")
+    if math.isfinite(a.sigma_min):
+        left.axhline(u("pressure", a.sigma_min), color="0.5", ls="-.", lw=0.8,
+                     label="minimum stress at injection depth")
+    right.plot(a.G, u("pressure", a.derivative), "s-", ms=2, color="C1", label="G dP/dG")
+    if math.isfinite(a.slope):  # a straight line through the origin was found
+        right.plot([0.0, float(a.G[-1])], [0.0, float(u("pressure", a.slope * a.G[-1]))], "--", color="C1", lw=0.8,
+                   label="line through the origin (open fracture)")
+    title = f"fall-off, G-function (alpha = {a.alpha:g}): "
+    if a.closure is not None:
+        c = a.closure
+        left.axvline(c.G, color="k", ls=":", lw=1)
+        left.plot([c.G], [u("pressure", c.pressure)], "kD",
+                  label=f"closure {_number(float(u('pressure', c.pressure)))} {unit}, "
+                        f"{_number(a.closure_time)} s after shut-in")
+        right.plot([c.G], [u("pressure", a.derivative[c.index])], "kD")
+        title += f"closure at G = {_number(c.G, '.3g')}, efficiency {_number(a.efficiency, '.2f')}"
+    else:
+        title += "no closure picked"
+    left.set(xlabel=f"G (alpha = {a.alpha:g}) [-]", ylabel=f"bottom-hole pressure [{unit}]", title=title)
+    right.set(ylabel=f"G dP/dG [{unit}]", ylim=(0, None))
+    handles = [*left.get_legend_handles_labels()[0], *right.get_legend_handles_labels()[0]]
+    fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize=7)
     return fig
 
 
@@ -651,6 +703,9 @@ def figures(results: Results, units: FigureUnits | None = None) -> dict[str, Fig
         out["fracture_volume_balance"] = volume_balance(results, units=u)
         if np.isfinite(results.fracture_balance.get("net_pressure", np.nan)).any():
             out["pressure_history"] = pressure_history(results, units=u)
+        analysis = falloff(results)
+        if analysis is not None:  # a run with a shut-in (records after the pumps stop)
+            out["fall_off"] = fall_off(results, units=u, analysis=analysis)
     if len(results.proppant_snapshots):
         last = results.proppant_snapshots[-1]
         out.update(proppant_volume_fraction=volume_fraction_map(last, layers, u),
@@ -674,10 +729,12 @@ def figures(results: Results, units: FigureUnits | None = None) -> dict[str, Fig
     return out
 
 
+#: The figures only a run with a shut-in (records after the pumps stop) gets.
+SHUT_IN_FIGURES = ("fall_off",)
 #: The figure names (file stems) ``figures`` can produce, by the kind of results that produces them.
 FIGURE_NAMES = {
     "fracture": ("fracture_width", "fracture_footprints", "fracture_area_efficiency", "fracture_volume_balance",
-                 "pressure_history"),
+                 "pressure_history", "fall_off"),
     "proppant": ("proppant_volume_fraction", "proppant_speed", "proppant_radius", "closure_maps",
                  "proppant_volume_balance"),
     "column": ("proppant_interfaces",),

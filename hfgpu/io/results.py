@@ -76,7 +76,7 @@ UNITS = {
     # the fracture engine's scalar snapshot extras (docs/results-format.md)
     **{f"front_{k}": "m" for k in ("radius", "radius_min", "radius_max", "up", "down", "left", "right")},
     "area": "m^2", "area_radius": "m", "inlet_width": "m", "length": "m", "height": "m",
-    "injected_volume": "m^3", "stored_volume": "m^3", "leaked_volume": "m^3",
+    "injected_volume": "m^3", "stored_volume": "m^3", "leaked_volume": "m^3", "closed_at": "s",
     # /closure (hfgpu.closure.conductivity.ClosureMap.fields)
     "propped_width": "m", "conductivity": "m^3", "closure_stress": "Pa", "permeability": "m^2",
     "solid_volume": "m^3", "sauter_diameter": "m", "propped": "1",

@@ -10,6 +10,9 @@ screen-out that did not happen, reads "never"):
 * end of pumping (when the pumps stop before the end of the run, read from ``/fracture/balance``: the last record
   at or before :func:`pump_end`): length, height, net pressure, BHTP (and STP) there, and the ISIP (and at the
   surface);
+* fall-off (a run with at least 2 records after the pumps stop, :func:`falloff_of`, hfgpu.fracture.falloff): the
+  closure picked on G dP/dG (pressure, time after the stop, G_c) and Nolte's efficiency from G_c, or one line
+  saying why none was picked;
 * fluid: pumped, in the fracture, leaked off, fluid efficiency, bottom-hole treating pressure (BHTP) at the end,
   and with ``[wellbore]`` the surface treating pressure (STP, :mod:`hfgpu.wellbore`) at the end;
 * proppant: pumped, in the fracture (in the domain, for a proppant-only run), held back at the inlet (screen-out) and when it began, left the domain, parcels,
@@ -39,7 +42,7 @@ from ..closure.display import unit_label as closure_unit
 from ..units import display_unit, format_number, in_display_units
 
 #: The groups in the order they are printed.
-GROUPS = ("fracture", "end of pumping", "fluid", "proppant", "run")
+GROUPS = ("fracture", "end of pumping", "fall-off", "fluid", "proppant", "run")
 
 
 def _first(summary: dict, *keys: str) -> Any:
@@ -88,8 +91,8 @@ def pump_end(scene: Any) -> float | None:
 def treatment_pressures(balance: dict[str, np.ndarray], stop: float | None,
                         stp: np.ndarray | None = None) -> dict[str, float]:
     """From a fracture step history (``/fracture/balance``) and the time the pumps stop: the state at the end of
-    pumping, the last record at or before ``stop`` (``pumping_time`` [s], ``pumping_length``, ``pumping_height``
-    [m], ``pumping_net_pressure``, ``pumping_bhtp`` [Pa]), and ``isip`` [Pa], the BHTP of the first record after
+    pumping, the last record at or before ``stop`` (``pumping_time`` [s], ``pumping_area`` [m^2],
+    ``pumping_length``, ``pumping_height`` [m], ``pumping_net_pressure``, ``pumping_bhtp`` [Pa]), and ``isip`` [Pa], the BHTP of the first record after
     ``stop``, at ``isip_time`` [s]. With ``stp``, the surface treating pressure of each record
     (:func:`hfgpu.wellbore.surface_pressure`), also ``pumping_stp`` and ``isip_surface`` [Pa]. Empty when the
     history has no record after ``stop`` (the run ended pumping, or no stop)."""
@@ -97,13 +100,32 @@ def treatment_pressures(balance: dict[str, np.ndarray], stop: float | None,
     if stop is None or not time.size or time[-1] <= stop or time[0] > stop:
         return {}
     last = int(np.searchsorted(time, stop, side="right")) - 1
-    out = dict(pumping_time=time[last], pumping_length=balance["length"][last],
+    out = dict(pumping_time=time[last], pumping_area=balance["area"][last], pumping_length=balance["length"][last],
                pumping_height=balance["height"][last], pumping_net_pressure=balance["net_pressure"][last],
                pumping_bhtp=balance["injection_pressure"][last], isip=balance["injection_pressure"][last + 1],
                isip_time=time[last + 1])
     if stp is not None:
         out.update(pumping_stp=stp[last], isip_surface=stp[last + 1])
     return {k: float(v) for k, v in out.items()}
+
+
+def falloff_of(balance: dict[str, np.ndarray] | None, stop: float | None):
+    """The fall-off of a step history (``/fracture/balance``) after the pumps stop at ``stop`` [s], read with G
+    (:func:`hfgpu.fracture.falloff.falloff_analysis` on ``injection_pressure``; the minimum stress at the
+    injection depth is ``injection_pressure - net_pressure`` of the rows after the stop); None without at least
+    2 rows after ``stop``."""
+    from ..fracture.falloff import falloff_analysis
+
+    if not balance or stop is None or "injection_pressure" not in balance:
+        return None
+    time, bhp = np.asarray(balance["time"], dtype=np.float64), np.asarray(balance["injection_pressure"], np.float64)
+    after = time > stop
+    stress = bhp[after] - np.asarray(balance.get("net_pressure", np.full(time.shape, np.nan)), np.float64)[after]
+    sigma_min = float(np.median(stress[np.isfinite(stress)])) if np.isfinite(stress).any() else math.nan
+    try:
+        return falloff_analysis(time, bhp, stop, sigma_min)
+    except ValueError:
+        return None
 
 
 def surface_history(balance: dict[str, np.ndarray] | None, scene: Any) -> np.ndarray | None:
@@ -125,11 +147,12 @@ def surface_history(balance: dict[str, np.ndarray] | None, scene: Any) -> np.nda
 
 def summary_rows(summary: dict[str, Any], system: str = "SI", density: float | None = None,
                  pressures: dict[str, float] | None = None,
-                 stp_end: float | None = None) -> list[tuple[str, str, str]]:
+                 stp_end: float | None = None, falloff: Any = None) -> list[tuple[str, str, str]]:
     """(group, label, value with its unit) of the rows the table shows, in order; ``density`` [kg/m^3] is the
     proppant's grain density when all classes share it (amounts then shown as masses); ``pressures`` is
     :func:`treatment_pressures` of the run (no end-of-pumping group without it); ``stp_end`` the STP [Pa] of the
-    last record (no STP row without it)."""
+    last record (no STP row without it); ``falloff`` the run's :func:`falloff_of` (no fall-off group without
+    it)."""
     s = summary
     rows: list[tuple[str, str, str | None]] = []
 
@@ -142,9 +165,12 @@ def summary_rows(summary: dict[str, Any], system: str = "SI", density: float | N
     add("fracture", "height", _quantity(_first(s, "height", "fracture_height"), "length", system))
     add("fracture", "width at the perforation", _quantity(_first(s, "w_inlet", "fracture_w_inlet"), "width", system))
     add("fracture", "net pressure at the end", _quantity(s.get("net_pressure_end"), "pressure", system))
+    closed = _first(s, "closed_at", "fracture_closed_at")
+    add("fracture", "closed (every cell)", _when(closed, system) if _finite(closed) else None)
     p = pressures or {}
     if p:
         add("end of pumping", "at", _when(p["pumping_time"], system))
+        add("end of pumping", "created area (one face)", _quantity(p.get("pumping_area"), "area", system))
         add("end of pumping", "length (tip to tip)", _quantity(p["pumping_length"], "length", system))
         add("end of pumping", "height", _quantity(p["pumping_height"], "length", system))
         add("end of pumping", "net pressure", _quantity(p["pumping_net_pressure"], "pressure", system))
@@ -153,6 +179,13 @@ def summary_rows(summary: dict[str, Any], system: str = "SI", density: float | N
         isip = _quantity(p["isip"], "pressure", system)
         add("end of pumping", "ISIP", f"{isip} (first record after, {_when(p['isip_time'], system)})" if isip else None)
         add("end of pumping", "ISIP at surface", _quantity(p.get("isip_surface"), "pressure", system))
+    if falloff is not None and falloff.closure is None:
+        add("fall-off", "closure", f"not picked: {falloff.note}")
+    elif falloff is not None:
+        add("fall-off", "closure pressure", _quantity(falloff.closure_pressure, "pressure", system))
+        add("fall-off", "closure time after shut-in", _when(falloff.closure_time, system))
+        add("fall-off", f"G at closure (alpha = {falloff.alpha:g})", format_number(falloff.G_c, 4))
+        add("fall-off", "efficiency at shut-in (Nolte, from G)", _percent(falloff.efficiency))
 
     add("fluid", "pumped", _quantity(s.get("injected_volume"), "volume", system))
     add("fluid", "in the fracture", _quantity(s.get("stored_volume"), "volume", system))
@@ -244,7 +277,8 @@ def summary_table(summary: dict[str, Any], system: str = "SI", scene: Any = None
     stp = surface_history(balance, scene)
     pressures = treatment_pressures(balance, pump_end(scene), stp) if balance and scene is not None else None
     stp_end = float(stp[-1]) if stp is not None and stp.size else None
-    return _table(summary_rows(summary, system, shared_density(scene), pressures, stp_end))
+    falloff = falloff_of(balance, pump_end(scene)) if balance and scene is not None else None
+    return _table(summary_rows(summary, system, shared_density(scene), pressures, stp_end, falloff))
 
 
 # ----------------------------------------------------------------------------------------------

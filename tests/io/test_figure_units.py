@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from hfgpu import load_scene
 from hfgpu.io.display_units import FigureUnits
-from hfgpu.io.plots import FIGURE_NAMES, LAYER_STYLE, figures
+from hfgpu.io.plots import FIGURE_NAMES, LAYER_STYLE, SHUT_IN_FIGURES, figures
 from hfgpu.io.results import ResultsWriter, open_results
 from hfgpu.records import SolidBalanceRecord
 from hfgpu.units import convert
@@ -75,7 +75,7 @@ def layered(tmp_path_factory):
 
 def test_field_fracture_figures_name_and_convert_their_units(layered):
     (_, si), (_, field) = layered["SI"], layered["field"]
-    assert tuple(field) == FIGURE_NAMES["fracture"]
+    assert tuple(field) == tuple(n for n in FIGURE_NAMES["fracture"] if n not in SHUT_IN_FIGURES)  # no shut-in
     for name, fig in field.items():
         assert not any(SI_UNITS.search(label) for label in _labels(fig)), (name, _labels(fig))
     width_si, width_field = si["fracture_width"], field["fracture_width"]
@@ -137,7 +137,8 @@ def test_scene_written_in_field_units_plots_in_field_units(tmp_path):
 
 def test_coupled_field_figures(tmp_path):
     si, field = figures(_coupled(tmp_path, "SI")), figures(_coupled(tmp_path, "field"))
-    assert set(field) == set(FIGURE_NAMES["fracture"] + FIGURE_NAMES["proppant"] + FIGURE_NAMES["coupled"])
+    assert set(field) == set(FIGURE_NAMES["fracture"] + FIGURE_NAMES["proppant"] + FIGURE_NAMES["coupled"]) - set(
+        SHUT_IN_FIGURES)   # the fake pumps to the end
     for name, fig in field.items():
         assert not any(SI_UNITS.search(label) for label in _labels(fig)), (name, _labels(fig))
         assert any(FIELD_UNITS.search(label) for label in _labels(fig)), (name, _labels(fig))

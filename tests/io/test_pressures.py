@@ -25,10 +25,11 @@ HFGPU = [sys.executable, "-c", "import sys; from hfgpu.cli import main; sys.exit
 
 def test_treatment_pressures_read_the_records_either_side_of_the_stop():
     balance = {"time": np.array([0.0, 10.0, 20.0, 25.0, 30.0]), "length": np.array([1.0, 2.0, 3.0, 3.0, 3.0]),
+               "area": np.array([1.0, 3.0, 6.0, 6.5, 6.5]),
                "height": np.array([1.0, 1.5, 2.0, 2.0, 2.0]), "net_pressure": np.array([5.0, 4.0, 3.0, 1.0, -1.0]),
                "injection_pressure": np.array([15.0, 14.0, 13.0, 11.0, 9.0])}
     p = treatment_pressures(balance, 20.0)
-    assert p == dict(pumping_time=20.0, pumping_length=3.0, pumping_height=2.0, pumping_net_pressure=3.0,
+    assert p == dict(pumping_time=20.0, pumping_area=6.0, pumping_length=3.0, pumping_height=2.0, pumping_net_pressure=3.0,
                      pumping_bhtp=13.0, isip=11.0, isip_time=25.0)
     assert treatment_pressures(balance, 30.0) == {}   # pumping to the end: no shut-in record
     assert treatment_pressures(balance, None) == {}

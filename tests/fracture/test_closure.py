@@ -1,0 +1,113 @@
+"""Closure after shut-in (simulator.py, "Closure"): a fracture that loses its fluid to Carter leak-off closes,
+its wetted footprint recedes to nothing, the run completes with steps that grow once nothing moves, and a
+second injection opens it again; the volume balance holds throughout."""
+
+import math
+
+import numpy as np
+import pytest
+
+from hfgpu.fracture.engine_state import LATER_ATTRIBUTES
+from hfgpu.fracture.simulator import simulate
+from hfgpu.records import MemorySink
+from hfgpu.scene import load_scene
+
+C_L = 2e-6   # Carter coefficient [m/s^0.5]
+SCENE = """
+[run]
+end_time = "{end}"
+physics = ["fracture"]
+
+[rock]
+youngs_modulus = "10 GPa"
+poisson_ratio = 0.25
+toughness = "0.5 MPa*m**0.5"
+leakoff_coefficient = "{c_l} m/s**0.5"
+min_stress = "6 MPa"
+
+[fluid]
+viscosity = "1e-3 Pa*s"
+
+[injection]
+depth = "1000 m"
+schedule = [{schedule}]
+
+[mesh]
+cell_size = "0.4 m"
+
+[output]
+every = "{end}"
+"""
+PUMP = '{ until = "20 s", rate = "5e-4 m**3/s" }'   # 0.01 m^3
+
+
+def run(schedule: str, end: str, c_l: float = C_L):
+    sink = MemorySink()
+    out = simulate(load_scene(SCENE.format(end=end, c_l=c_l, schedule=schedule)), sink)
+    rows = sink.fracture_balances
+    return out, {k: np.array([getattr(r, k) for r in rows]) for k in ("time", "injected", "stored", "leaked",
+                                                                       "area")}
+
+
+@pytest.fixture(scope="module")
+def shut_in():
+    return run(PUMP + ', { until = "3000 s", rate = "0 m**3/s" }', "3000 s")
+
+
+def test_a_draining_fracture_closes_and_the_run_completes(shut_in):
+    out, b = shut_in
+    assert out["time"] == 3000.0 and math.isfinite(out["closed_at"])
+    # Carter's law (2 C_L sqrt(t) per face, two faces) cannot leak the injected 0.01 m^3 over the largest
+    # footprint before t = (V / (4 C_L A_max))^2: the closure comes after that bound
+    bound = (0.01 / (4.0 * C_L * b["area"].max())) ** 2
+    assert bound < out["closed_at"] < 3.0 * bound, (bound, out["closed_at"])
+    # the wetted footprint recedes to nothing; all the fluid has leaked off; steps grow once it has closed
+    pumped = b["time"] <= 20.0
+    draining = (b["time"] > 20.0) & (b["time"] < out["closed_at"])
+    assert b["area"][draining][-1] < 0.5 * b["area"][pumped][-1]
+    assert out["area"] == 0.0 and out["stored"] == 0.0
+    assert out["leaked"] == pytest.approx(0.01, rel=1e-9)
+    assert np.all(np.abs(b["injected"] - b["stored"] - b["leaked"]) < 1e-9 * 0.01)
+    assert int(np.sum(b["time"] > out["closed_at"])) < 15
+
+
+def test_a_second_injection_opens_the_closed_fracture_again(shut_in):
+    first, _ = shut_in
+    out, b = run(PUMP + ', { until = "1500 s", rate = "0 m**3/s" }, { until = "1530 s", rate = "5e-4 m**3/s" },'
+                 ' { until = "4000 s", rate = "0 m**3/s" }', "4000 s")
+    assert first["closed_at"] < 1500.0
+    second = (b["time"] > 1500.0) & (b["time"] <= 1530.0)
+    assert b["area"][second].max() > 0.5 * b["area"][b["time"] <= 20.0].max()
+    assert out["closed_at"] > 1530.0 and out["leaked"] == pytest.approx(0.025, rel=1e-9)
+    assert np.all(np.abs(b["injected"] - b["stored"] - b["leaked"]) < 1e-9 * b["injected"])
+
+
+def test_without_leak_off_a_shut_in_fracture_never_closes():
+    out, b = run(PUMP + ', { until = "200 s", rate = "0 m**3/s" }', "200 s", c_l=0.0)
+    assert math.isnan(out["closed_at"]) and out["area"] >= b["area"][b["time"] <= 20.0][-1]
+    assert out["stored"] == pytest.approx(0.01, rel=1e-6)
+
+
+def test_a_checkpoint_written_before_closure_existed_resumes():
+    """A state without the closure's attributes takes the grid's largest width as the peak and 'not closed'."""
+    state = {"grid": {"fields": {"w": np.array([[0.0, 2e-4], [1e-4, 0.0]])}}}
+    assert LATER_ATTRIBUTES["w_peak"](state) == 2e-4 and math.isnan(LATER_ATTRIBUTES["t_closed"](state))
+
+
+def test_the_dfit_scene_closes_and_its_fall_off_is_read():
+    """hfgpu/scenes/dfit.toml (field units): 12 bbl in 4 min, 6 h shut in. The run completes closed, and the
+    summary shows the state at the end of pumping and the fall-off group."""
+    from importlib.resources import files
+
+    from hfgpu.io.summary import summary_rows, treatment_pressures
+
+    scene = load_scene((files("hfgpu") / "scenes" / "dfit.toml").read_text())
+    sink = MemorySink()
+    out = simulate(scene, sink)
+    assert 240.0 < out["closed_at"] < 21600.0 and out["area"] == 0.0
+    balance = {k: np.array([getattr(r, k) for r in sink.fracture_balances])
+               for k in ("time", "area", "length", "height", "net_pressure", "injection_pressure")}
+    pressures = treatment_pressures(balance, scene.injection.schedule.pump_end)
+    assert pressures["pumping_area"] > 0.0 and pressures["isip"] < pressures["pumping_bhtp"]
+    labels = [label for group, label, _ in summary_rows(out, "field", pressures=pressures)]
+    assert "closed (every cell)" in labels
