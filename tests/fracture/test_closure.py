@@ -111,3 +111,15 @@ def test_the_dfit_scene_closes_and_its_fall_off_is_read():
     assert pressures["pumping_area"] > 0.0 and pressures["isip"] < pressures["pumping_bhtp"]
     labels = [label for group, label, _ in summary_rows(out, "field", pressures=pressures)]
     assert "closed (every cell)" in labels
+
+
+def test_a_sub_grid_front_shut_in_with_leak_off_is_warned_of():
+    from hfgpu.scene_checks import validate
+
+    shut = SCENE.format(end="3000 s", c_l=C_L, schedule=PUMP + ', { until = "3000 s", rate = "0 m**3/s" }')
+    subgrid = shut.replace("[mesh]", '[fracture]\nfront_tracking = "subgrid"\n\n[mesh]')
+    assert any("do not close" in w for w in validate(load_scene(subgrid)).warnings)
+    assert not any("do not close" in w for w in validate(load_scene(shut)).warnings)
+    pumping = SCENE.format(end="20 s", c_l=C_L, schedule=PUMP).replace("[mesh]", '[fracture]\nfront_tracking = '
+                                                                         '"subgrid"\n\n[mesh]')
+    assert not any("do not close" in w for w in validate(load_scene(pumping)).warnings)
