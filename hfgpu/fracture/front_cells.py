@@ -9,10 +9,11 @@ which the front reconstructed from the widths (front.front_distances, the tip as
 cells) moves more than ``max_front_advance`` cells, is redone with half the step.
 
 The footprint counts an edge cell by the part of it behind the straight front at the inverted tip distance
-(geometry.filled_fraction with ``distances``), the distances of the solved cells: a cell opened at the view's
-time (width 0, ``Grid.unsolved``) counts only the part of it the front of its solved neighbours reaches past
-their shared face (the criterion opened it when that front reached the face); a coarsening carries no front (every coarse cell a channel cell,
-the next step's distances place it again).
+(geometry.filled_fraction with ``distances``). A cell the criterion has just opened (width 0, no solve has seen
+it) counts as an edge cell with the front at its centre, unless it lies in rock of a higher minimum stress than
+its open neighbours and their fluid pressure is below that stress: the next solve will hold it shut (contact),
+so it is left out (``held``): a barrier row the front reached at the last step is not fracture height. A
+coarsening carries no front (every coarse cell a channel cell, the next step's distances place it again).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from .coarsen import Coarsening, channel_front
-from .front import cells_to_open, front_distances
+from .front import DIRECTIONS, cells_to_open, front_distances, shift
 from .geometry import filled_fraction
 from .views import View, distances
 
@@ -54,13 +55,34 @@ class CellFront:
         return dt
 
     def filled_fraction(self, engine, view: View) -> np.ndarray:
-        """Each box cell's filled fraction: the solved cells' edges by their inverted tip distances, a cell
-        opened at the view's time by the part of it that front reaches (module docstring, geometry.py)."""
+        """Each box cell's filled fraction: edge cells by their inverted tip distances (geometry.py), without
+        the cells ``held`` shut by a higher stress (module docstring)."""
         g = view.grid
-        solved = g["active"] & ~g.unsolved(view.t)
-        found = front_distances(engine.tip, solved, g["w"], g["p"], view.kprime_box, view.cprime_box,
+        held = self.held(engine, view)
+        if not held.any():
+            return filled_fraction(self.name, g["active"], g["fill"], distances(engine, view), g.dx, g.dz,
+                                   g.shut(view.t))
+        active = g["active"] & ~held
+        found = front_distances(engine.tip, active, g["w"], g["p"], view.kprime_box, view.cprime_box,
                                 g["reached"], view.t, g.dx, g.dz)
-        return filled_fraction(self.name, solved, g["fill"], found, g.dx, g.dz, g.shut(view.t))
+        return filled_fraction(self.name, active, g["fill"], found, g.dx, g.dz, g.shut(view.t))
+
+    @staticmethod
+    def held(engine, view: View) -> np.ndarray:
+        """Cells the front criterion opened at the view's time (no solve has seen them, ``Grid.unsolved``) in
+        rock of a higher minimum stress than each open neighbour's, where that neighbour's fluid pressure is
+        below their own stress: the next solve holds them shut (contact)."""
+        g = view.grid
+        new = g.unsolved(view.t)
+        if not new.any():
+            return new
+        sigma = engine.scene.rock.min_stress_at(g.centres()[1])
+        wet = g["active"] & ~new & (g["w"] > 0.0)
+        fed = np.zeros(new.shape, bool)
+        for dk, di in DIRECTIONS:
+            beside, p, s = shift(wet, dk, di, False), shift(g["p"], dk, di, 0.0), shift(sigma, dk, di, np.inf)
+            fed |= beside & ((sigma <= s) | (p > sigma))
+        return new & ~fed
 
     def tip_normals(self, engine, view: View) -> tuple[np.ndarray, None, None]:
         """No tip cells (the front lies on cell edges): an all-False mask and no normals."""

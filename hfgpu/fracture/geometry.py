@@ -20,17 +20,14 @@ How each front gives f (``filled_fraction``):
   closed cells (capped at one cell, as the front summary). Its f is the exact part of the cell behind the
   straight front at distance s along the outward normal n, n the normalised sum of the directions of those
   sides (tip_cells.wetted_fraction: f = 1/2 + s / h on a side of a straight front, the diagonal cut in a
-  corner, at most 1); f = 1 in cells with no closed neighbour. The distances are those of the solved cells (the cells the last solve
-  included): where one reaches past its cell's face (s > h/2 on that side), the part beyond, s - h/2 (at
-  most half a cell, s being capped at one), is the filled fraction of the neighbour on that side unless a
-  solve holds that neighbour shut, so a straight side counts 1/2 + s/h over the two cells (a fully open
-  rectangle with s = h/2 at its edges, the front on its faces, gives exactly its own area). A cell the front
-  criterion opened at the view's time (Eq. 33 at s = h/2: when the front reached its face) has width 0 and
-  carries no front of its own: it counts only that part. ``python bench/bench_fracture.py --cases long``
-  prints the radii from the area and from the front.
+  corner); f = 1 in cells with no closed neighbour. A fully open rectangle (s >= one cell at its edges)
+  gives exactly its own area. The same inverted distances give the front summary's radius, so the area and
+  the front agree (``python bench/bench_fracture.py --cases long`` prints both radii's errors).
 
 Cells that contact holds shut (width 0 after their opening, newton.py) hold no fluid and count 0 in either
-mode: a barrier row that the front opened and the stress closed again is not fracture area.
+mode: a barrier row that the front opened and the stress closed again is not fracture area. With whole cells,
+a cell the criterion has just opened in higher-stress rock that its neighbours' fluid pressure cannot open is
+left out of the footprint too (front_cells.CellFront.held).
 
 The fluid volume of the footprint is V = dx dz sum_cells w: a tip cell's width is its cell mean (the tip
 asymptote's mean over the wetted part with the sub-grid front), so V is the stored volume of the balance.
@@ -42,7 +39,7 @@ import math
 
 import numpy as np
 
-from .front import DIRECTIONS, shift
+from .front import DIRECTIONS
 from .tip_cells import wetted_fraction
 
 
@@ -52,8 +49,7 @@ def filled_fraction(mode: str, active: np.ndarray, fill: np.ndarray, distances: 
     cells ``shut`` (held closed by contact: no fluid, not part of the fracture's area); ``mode`` is
     ``front_tracking``; ``fill``: the sub-grid front's wetted fractions; ``distances``: with cells, the front's
     distance from each edge cell's centre per side facing a closed cell (front.front_distances, in the order
-    of front.DIRECTIONS; NaN elsewhere); with them, a cell outside ``active`` and ``shut`` counts the part of it
-    those fronts reach past its faces."""
+    of front.DIRECTIONS; NaN elsewhere)."""
     if shut is not None:
         active = active & ~shut
     if mode == "subgrid":
@@ -68,13 +64,7 @@ def filled_fraction(mode: str, active: np.ndarray, fill: np.ndarray, distances: 
     norm = np.where(edge, np.hypot(nx, nz), 1.0)
     advance = np.where(edge, np.clip(reach, 0.0, max(dx, dz)), 0.0)
     edge_fraction = wetted_fraction(advance, nx / norm, nz / norm, dx, dz)
-    inside = np.where(edge, edge_fraction, np.where(active, 1.0, 0.0))
-    beyond = np.zeros(active.shape)
-    for (dk, di), s in zip(DIRECTIONS, distances):
-        past = np.where(np.isfinite(s) & active, np.clip(s / (dz if dk else dx) - 0.5, 0.0, 0.5), 0.0)
-        beyond = np.maximum(beyond, shift(past, dk, di, 0.0))
-    held = active if shut is None else active | shut
-    return np.where(held, inside, beyond)
+    return np.where(edge, edge_fraction, np.where(active, 1.0, 0.0))
 
 
 def footprint(fraction: np.ndarray, dx: float, dz: float) -> dict[str, float]:

@@ -53,16 +53,12 @@ def positive_part(w: np.ndarray, delta: float) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (w + root), 0.5 * (1.0 + w / root)
 
 
-def conductance(faces: Faces, w: np.ndarray, delta: float = 0.0, w_closed: float = 0.0):
-    """T = g (w+_a + w+_b)^3 of each face (w+ the smoothed positive part) and the derivatives dT/dw_a,
-    dT/dw_b. A face whose two cells are closed (w+_a + w+_b below 2 ``w_closed``, the engine's closure width)
-    conducts as an aperture of 2 w_closed: the walls in contact still pass pressure between closed cells (a
-    residual aperture), so a closed region's pressures stay determined."""
+def conductance(faces: Faces, w: np.ndarray, delta: float = 0.0):
+    """T = g (w+_a + w+_b)^3 of each face (w+ the smoothed positive part: a closed cell conducts nothing)
+    and the derivatives dT/dw_a, dT/dw_b."""
     wp, dwp = positive_part(w, delta)
     s = wp[faces.a] + wp[faces.b]
-    shut = s < 2.0 * w_closed
-    s = np.where(shut, 2.0 * w_closed, s)
-    ds = np.where(shut, 0.0, 3.0 * faces.g * s**2)
+    ds = 3.0 * faces.g * s**2
     return faces.g * s**3, ds * dwp[faces.a], ds * dwp[faces.b]
 
 

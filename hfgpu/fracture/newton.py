@@ -98,7 +98,9 @@ class StepProblem:
     w_smooth: float = 0.0     # smoothing width of the conductance's positive part [m]
     pinned: np.ndarray | None = None   # prescribed widths (tip cells of the sub-grid front), NaN: unknown [m]
     wetted: np.ndarray | None = None   # wetted fraction of each cell's area that leaks (None: all of it)
-    w_floor: float = 0.0      # a width below which a cell is closed (the engine's closure width) [m]
+    w_floor: float = 0.0      # the engine's closure width [m]: a face between two closed cells conducts as an
+    #                           aperture of 2 w_floor (the walls in contact still pass pressure, so a closed
+    #                           region's pressures stay determined); Newton's convergence test floors ||w|| there
 
 
 @dataclass
@@ -174,7 +176,11 @@ def residual(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.n
     """Eq. 29 residual F(x) with the widths and pressures of ``_split``, plus the conductances and the
     ramp."""
     w, p = _split(prob, elastic, x, closed)
-    t, *dt_dw = conductance(prob.faces, w, prob.w_smooth, prob.w_floor)
+    t, *dt_dw = conductance(prob.faces, w, prob.w_smooth)
+    if closed is not None and prob.pinned is None and prob.w_floor > 0.0:   # walls in contact: an aperture
+        shut = closed[prob.faces.a] & closed[prob.faces.b]                  # of 2 w_floor between closed cells
+        t = np.where(shut, np.maximum(t, prob.faces.g * (2.0 * prob.w_floor) ** 3), t)
+        dt_dw = [np.where(shut, 0.0, d) for d in dt_dw]
     g, dg = leak_fraction(prob, w)
     f = (prob.area * (w - prob.w_old) + prob.area * prob.demand * g - prob.dt * net_inflow(prob.faces, t, p)
          - prob.source)

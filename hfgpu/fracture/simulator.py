@@ -23,13 +23,16 @@ opening times follow that vertex's R ~ t^a (tau = t0 (r / R0)^(1/a)). The cells 
 their opening times (at most 90 % of it), in the shape a uniform net pressure gives (C w = const).
 
 Closure. Carter leak-off drains a shut-in fracture; the positivity ramp (leakoff.available_fraction) keeps a
-draining cell's width above 0, so without a rule its walls would never meet. A cell whose width falls over a
-step below ``closure_width_fraction`` of the largest width the fracture has had (``w_peak``) is closed at the
-end of that step: width 0, the film left in it added to the leak-off (the fluid it holds is what Carter's law
-would take from it within the step; the balance stays exact), and from then on it is a contact cell
-(newton.solve_step): it leaks no more, counts no area (geometry.py), and opens again when the fluid pressure
-exceeds the stress that holds it shut (a second injection). ``t_closed`` is the time the last open cell closed
-(NaN while any cell is open); the summary reports it.
+draining cell's width above 0, so without a rule its walls would never meet. A cell whose width falls, over a
+step without injection, below ``closure_width_fraction`` of the largest width the fracture has had (``w_peak``)
+is closed at the end of that step (while pumping, the ramp alone governs starved cells): width 0, the film left
+in it added to the leak-off (Carter's law would take it within the step; the balance stays exact), and from
+then on it is a contact cell (newton.solve_step): it leaks no more, counts no area (geometry.py), passes
+pressure to closed neighbours through a residual aperture (newton.StepProblem.w_floor), and opens again when
+the fluid pressure exceeds the stress that holds it shut (a second injection: the perforated cell starts that
+step open). A fracture whose cells are all closed and that takes no injection has nothing to solve: its steps
+cost nothing and grow. ``t_closed`` is the time the last open cell closed (NaN while any cell is open); the
+summary reports it.
 
 Coarsening. With ``mesh.max_cells_across`` set, the grid is coarsened by ``mesh.coarsening_factor`` (coarsen.py:
 3x3 merges, or PyFrac's 2x remeshing by area overlap; both centre a coarse cell on the injection cell) after a
@@ -297,7 +300,8 @@ class _Engine:
         self.t += dt
         w_old = g["w"][sel]
         self.w_peak = max(self.w_peak, float(res.w.max()))
-        drained = (res.w > 0.0) & (res.w < self.num.closure_width_fraction * self.w_peak) \
+        shut_in = self.schedule.mean_rate(t_a, self.t) <= 0.0
+        drained = shut_in & (res.w > 0.0) & (res.w < self.num.closure_width_fraction * self.w_peak) \
             & (g["opened"][sel] < t_a)   # a cell opened at the step's start has one step to fill
         if pinned is not None:
             drained &= ~pinned

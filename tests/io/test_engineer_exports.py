@@ -197,15 +197,16 @@ def test_the_summary_height_of_a_known_footprint_is_its_open_rows():
     assert rows["created area (one face)"] == "6 000 ft^2"
 
 
-def test_the_summary_height_is_the_open_rows_and_the_front_past_them(fracture_run):
-    """5 open rows of 10 ft between 1000 psi barriers: the height is 50 ft plus the part of the barrier rows the
-    front of the solved cells reaches (geometry.py), under half a cell in all; the barrier cells the front
-    criterion opened at the last step (width 0, not yet solved) count only that part, not half a row each."""
+def test_the_summary_height_is_the_extent_of_the_open_rows(fracture_run):
+    """5 open rows of 10 ft between 1000 psi barriers: 50 ft. The barrier cells the front criterion opened at
+    the last step, which the next solve would hold shut, are no fracture height (front_cells.CellFront.held)."""
     path, stdout, _ = fracture_run
     snap = open_results(path).fracture_snapshots[-1]
-    assert int((snap.width > 0).sum(axis=0).max()) == 5
+    open_rows = int((snap.width > 0).sum(axis=0).max())
     line = next(x for x in stdout.splitlines() if x.strip().startswith("height"))
-    assert line.split()[-1] == "ft" and 50.0 <= float(line.split()[-2]) < 55.0, line
+    assert open_rows == 5 and line.split()[-2:] == [format_number(open_rows * 10.0), "ft"]
+    assert all(abs(float(s.extras["height"]) - 5 * convert(10.0, "ft", "m")) < 1e-9
+               for s in open_results(path).fracture_snapshots)
 
 
 def test_the_summary_speaks_one_style_in_field_units(fracture_run):
