@@ -13,10 +13,11 @@ is V_L(t) = 2 A_e C_L sqrt(t_p) g(dt_D, alpha), dt_D = (t - t_p) / t_p, with
 ((2) is Valko & Economides' closed form with the Gauss hypergeometric function; tests/fracture/test_falloff.py
 checks it against the quadrature (1) and against the closed forms below). Particular cases:
 
-    alpha = 1/2 (high efficiency):  g = (1 + dt_D) arcsin((1 + dt_D)^(-1/2)) + dt_D^(1/2),  g_0 = pi/2
-    alpha = 1   (low efficiency):   g = (4/3) ((1 + dt_D)^(3/2) - dt_D^(3/2)),            g_0 = 4/3
+    alpha = 1/2 (low efficiency):   g = (1 + dt_D) arcsin((1 + dt_D)^(-1/2)) + dt_D^(1/2),  g_0 = pi/2
+    alpha = 1   (high efficiency):  g = (4/3) ((1 + dt_D)^(3/2) - dt_D^(3/2)),            g_0 = 4/3
 
-and G(dt_D) = (4/pi) (g(dt_D) - g_0), g_0 = g(0), so that G(0) = 0 and the volume leaked after shut-in is
+(Carter-dominated growth, A ~ t^(1/2), is the low-efficiency bound; A ~ t the high-efficiency one), and
+G(dt_D) = (4/pi) (g(dt_D) - g_0), g_0 = g(0), so that G(0) = 0 and the volume leaked after shut-in is
 (pi/2) A_e C_L sqrt(t_p) G.
 
 Mass balance after shut-in (Nolte 1979; Valko & Economides 1995, ch. 9): with the fracture's compliance
