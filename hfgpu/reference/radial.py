@@ -154,6 +154,17 @@ def k_vertex(E_prime, K_prime, Q0, t) -> VertexSolution:
                           net_pressure=K_PRESSURE * (K**6 / (E * Q * t)) ** 0.2)
 
 
+MP_RADIUS = 0.836406   # the viscous pulse's radius coefficient, PyFrac's HF_reference_solutions.Mp_vertex_solution
+
+
+def mp_pulse_radius(E_prime, mu_prime, V0, t):
+    """Radius of a viscosity-dominated (Mp vertex) pulse, a radial fracture that holds a finite volume V0 of
+    fluid without leak-off, long after its injection stopped: R = 0.836406 (E' V0^3 t / mu')^{1/9}, t the time
+    since the start of the injection (PyFrac's Mp_vertex_solution)."""
+    E, mu, V, t = (positive(n, v) for n, v in (("E_prime", E_prime), ("mu_prime", mu_prime), ("V0", V0), ("t", t)))
+    return MP_RADIUS * (E * V**3 * t / mu) ** (1.0 / 9.0)
+
+
 LEAKOFF_RADIUS = np.sqrt(2.0) / np.pi   # 0.4502
 MT_OPENING = 1.0493                     # Madyarova (2003) Omega(0): PyFrac's Mt_vertex_solution fit at rho = 0
 
