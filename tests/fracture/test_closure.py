@@ -141,3 +141,25 @@ def test_without_leak_off_a_shut_in_fracture_spreads_as_the_viscous_pulse():
     ref = mp_pulse_radius(scene.rock.plane_strain_modulus, 12.0 * scene.fluid.viscosity, 1.0, 1e5)
     assert out["area_radius"] == pytest.approx(ref, rel=0.02) and out["radius"] == pytest.approx(ref, rel=0.02)
     assert math.isnan(out["closed_at"]) and out["max_balance_error"] < 1e-9
+
+
+def test_without_leak_off_a_tough_fracture_arrests_at_the_penny_crack_radius():
+    """radial_III.toml (toughness-dominated) without leak-off, 0.1 m cells, shut in at 100 s: it arrests where a
+    penny crack holding V0 = 3e-3 m^3 under uniform pressure has K_I = K_Ic, R = (3 E' V0 / (8 sqrt(pi)
+    K_Ic))^(2/5) (Sneddon 1946), and never passes it. Measured: from the area -0.18 % (its largest over the run),
+    the front's mean +0.94 %."""
+    from importlib.resources import files
+
+    text = (files("hfgpu") / "scenes" / "radial_III.toml").read_text()
+    text = (text.replace('end_time = "405.8 s"', 'end_time = "4000 s"')
+            .replace('schedule = [{ until = "405.8 s", rate = "3e-5 m**3/s" }]',
+                     'schedule = [{ until = "100 s", rate = "3e-5 m**3/s" }, { until = "4000 s", rate = "0 m**3/s" }]')
+            .replace('leakoff_coefficient = "1e-7 m/s**0.5"', 'leakoff_coefficient = "0 m/s**0.5"')
+            .replace('cell_size = "0.25 m"', 'cell_size = "0.1 m"'))
+    scene = load_scene(text)
+    sink = MemorySink()
+    out = simulate(scene, sink)
+    arrest = (3.0 * scene.rock.plane_strain_modulus * 3e-3 / (8.0 * math.sqrt(math.pi) * scene.rock.toughness)) ** 0.4
+    assert out["area_radius"] == pytest.approx(arrest, rel=0.02) and out["radius"] == pytest.approx(arrest, rel=0.02)
+    largest = math.sqrt(max(b.area for b in sink.fracture_balances) / math.pi)
+    assert largest < 1.02 * arrest and math.isnan(out["closed_at"])
