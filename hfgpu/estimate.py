@@ -13,13 +13,19 @@ Q / (4 d w(0)), the rate leaving the perforated cell of side d through its four 
 proppant is pumped); at most ``max_parcels`` parcels; their product with ``particle_substeps``, the parcel
 updates, is what the particle engine's speed multiplies (docs/benchmarks.md measures both engines).
 
+Closure after shut-in (``closure_after``): Nolte's (1979) relation between the efficiency at the end of pumping
+and the G-function at closure, eta = G_c / (4 g_0 / pi + G_c) (hfgpu.fracture.falloff, alpha = 1/2: Carter-
+dominated area growth, the bound that closes soonest), solved for the time after shut-in at which G(dt_D) = G_c:
+dt_c = t_p dt_D. None without leak-off (the fracture never closes).
+
 Warnings (:func:`warnings`):
 
 * a proppant whose largest grain x ``bridging_factor`` exceeds the expected opening at the perforation when it
   is first pumped: it bridges there (a screen-out at the inlet) unless the fracture is wider;
 * a fracture that reaches fewer than :data:`MIN_CELLS_RADIUS` cells from the perforation by the end of pumping
   (the rate is too low for the leak-off, or the cells too large): the grid does not resolve it;
-* a fluid efficiency below :data:`MIN_EFFICIENCY` at the end of pumping: leak-off takes nearly all the fluid.
+* a fluid efficiency below :data:`MIN_EFFICIENCY` at the end of pumping: leak-off takes nearly all the fluid;
+* a shut-in longer than :data:`LONG_SHUT_IN` times the pumping time (with the expected closure time).
 """
 
 from __future__ import annotations
@@ -39,6 +45,10 @@ DIGITS = 3
 #: K' [Pa m^1/2] used for a rock without toughness (the closed form needs K' > 0; the viscosity-storage radius of
 #: a 0.1 m^3/s, 12 cP, E' 20 GPa fracture at 600 s is then within 0.2 % of Savitski & Detournay's 126.4 m).
 MIN_TOUGHNESS = 1e3
+#: A shut-in longer than this many times the pumping time is warned of.
+LONG_SHUT_IN = 1e6
+#: Area-growth exponent of the closure estimate (Carter-dominated growth).
+CLOSURE_ALPHA = 0.5
 
 
 @dataclass(frozen=True)
@@ -55,6 +65,7 @@ class Estimate:
     opening: float
     first_openings: dict[str, tuple[float, float]]
     cells: float
+    closure_after: float | None
     proppant_steps: int | None
     parcels: int | None
     parcel_updates: float | None
@@ -101,6 +112,7 @@ def estimate(scene: Any) -> Estimate | None:
         t_seen = max(t, 1e-3 * t_pump)  # sand from the first second: the opening a moment after it starts
         first[name] = (t, float(radial(t_seen).w0[-1]))
     cells = math.pi * radius**2 / (scene.mesh.dx * scene.mesh.dz)
+    closure = closure_after(float(end.efficiency[-1]), t_pump) if groups.C_prime > 0.0 else None
     steps = parcels = updates = None
     if scene.proppant is not None and scene.coupling is not None and first:
         numerics = scene.proppant.numerics
@@ -112,8 +124,24 @@ def estimate(scene: Any) -> Estimate | None:
         if parcels is not None:
             updates = float(steps) * numerics.particle_substeps * parcels
     return Estimate(pumping_time=t_pump, rate=rate, radius=radius, efficiency=float(end.efficiency[-1]),
-                    opening=float(end.w0[-1]), first_openings=first, cells=cells, proppant_steps=steps,
+                    opening=float(end.w0[-1]), first_openings=first, cells=cells, closure_after=closure,
+                    proppant_steps=steps,
                     parcels=parcels, parcel_updates=updates)
+
+
+def closure_after(efficiency: float, pumping_time: float) -> float:
+    """Time [s] after shut-in at which a fracture of this efficiency at the end of pumping closes (module
+    docstring: Nolte's G at closure, G_c = (4 g_0 / pi) eta / (1 - eta))."""
+    from scipy.optimize import brentq
+
+    from .fracture.falloff import G_function, g0
+
+    eta = min(max(efficiency, 1e-9), 1.0 - 1e-9)
+    g_c = 4.0 * g0(CLOSURE_ALPHA) / math.pi * eta / (1.0 - eta)
+    upper = 1.0
+    while float(G_function(upper, CLOSURE_ALPHA)) < g_c:
+        upper *= 4.0
+    return pumping_time * brentq(lambda d: float(G_function(d, CLOSURE_ALPHA)) - g_c, 0.0, upper, xtol=1e-12)
 
 
 def report(scene: Any, system: str) -> str:
@@ -129,6 +157,11 @@ def report(scene: Any, system: str) -> str:
              f"opening at the perforation {display_text(e.opening, 'width', system, DIGITS)}, fluid efficiency "
              f"{format_number(100.0 * e.efficiency, 2)} %",
              f"  {'fracture cells':32} ~{format_number(e.cells, 2)} (pi R^2 / cell area)"]
+    if scene.run.end_time > e.pumping_time * (1.0 + 1e-9):
+        closes = ("never (no leak-off)" if e.closure_after is None else
+                  f"about {display_text(e.closure_after, 'time', system, DIGITS)} after shut-in (Nolte's G at that "
+                  "efficiency)")
+        lines.append(f"  {'closure':32} {closes}")
     for name, (t, w0) in e.first_openings.items():
         lines.append(f"  {'opening when ' + name + ' starts':32} {display_text(w0, 'width', system, DIGITS)} "
                      f"(t = {format_number(t / 60.0, 3)} min)")
@@ -159,6 +192,13 @@ def warnings(scene: Any, system: str) -> list[str]:
                      f"is expected in the fracture at the end of pumping (rock.leakoff_coefficient at the injection "
                      f"depth, mean rate {display_text(e.rate, 'rate', system, DIGITS)}): leak-off takes nearly all of "
                      "it and the fracture stays small; a higher rate or a lower leak-off opens it")
+    shut_in = scene.run.end_time - e.pumping_time
+    if shut_in > LONG_SHUT_IN * e.pumping_time:
+        closes = ("it never closes without leak-off" if e.closure_after is None else
+                  f"the fracture is expected to close about {display_text(e.closure_after, 'time', system, DIGITS)} "
+                  "after shut-in (Nolte's G)")
+        found.append(f"run.end_time: the shut-in lasts {shut_in / e.pumping_time:.2g} times the pumping time; "
+                     f"{closes}")
     if scene.proppant is None:
         return found
     factor = scene.proppant.params.bridging_factor

@@ -96,3 +96,28 @@ def test_a_rock_without_toughness_gets_the_viscosity_storage_radius():
     g = scaled_parameters(scene.rock.youngs_modulus, scene.rock.poisson_ratio, 0.0, scene.fluid.viscosity, 0.0)
     assert e.radius == pytest.approx(float(m_vertex(g.E_prime, g.mu_prime, e.rate, 3000.0).R), rel=0.01)
     assert e.efficiency == pytest.approx(1.0)
+
+
+def test_the_closure_after_shut_in_is_nolte_s_and_a_very_long_shut_in_is_warned():
+    """closure_after solves Nolte's eta = G_c / (4 g_0 / pi + G_c) (alpha = 1/2) for the time: G at that time
+    gives back the efficiency. The DFIT scene (12 bbl in 4 min, 6 h shut in) expects closure some 30 min after
+    shut-in; 10^7 times the pumping time of shut-in is warned of, with that time; without leak-off, never."""
+    import math
+
+    from importlib.resources import files
+
+    from hfgpu.estimate import closure_after
+    from hfgpu.fracture.falloff import G_function, g0
+
+    after = closure_after(0.6, 100.0)
+    g_c = float(G_function(after / 100.0, 0.5))
+    assert g_c / (4.0 * g0(0.5) / math.pi + g_c) == pytest.approx(0.6, rel=1e-9)
+    dfit = (files("hfgpu") / "scenes" / "dfit.toml").read_text()
+    e = estimate(validate(load_scene(dfit)))
+    assert 10.0 * 60.0 < e.closure_after < 60.0 * 60.0
+    assert not any("shut-in lasts" in w for w in validate(load_scene(dfit)).warnings)
+    long = dfit.replace('end_time = "6 h"', 'end_time = "1e8 min"').replace('until = "6 h"', 'until = "1e8 min"')
+    found = [w for w in validate(load_scene(long)).warnings if "shut-in lasts" in w]
+    assert len(found) == 1 and "expected to close about" in found[0] and "run.end_time" in found[0]
+    dry = long.replace('leakoff_coefficient = "0.0001 ft/min**0.5"', 'leakoff_coefficient = "0 ft/min**0.5"')
+    assert any("never closes without leak-off" in w for w in validate(load_scene(dry)).warnings)
