@@ -134,8 +134,9 @@ def superposition_derivative(G, p, window: float = DEFAULT_WINDOW) -> np.ndarray
 @dataclass(frozen=True)
 class ClosurePick:
     """Where G dP/dG leaves the line through the origin: closure's G, pressure [Pa], time [s] (None without
-    times), the index of the record, the line's slope m [Pa] (G dP/dG = m G while open) and the side it left
-    to ("below": the derivative falls under the line, normal closure; "above")."""
+    times), the index of the record, the line's slope m [Pa] (G dP/dG = m G while open; NaN for a "peak" pick)
+    and the side it left to ("below": the derivative falls under the line, normal closure; "above"; "peak": the
+    curve had no straight early part and closure is where it turns down)."""
     G: float
     pressure: float
     time: float | None
@@ -146,7 +147,7 @@ class ClosurePick:
 
 #: Why no closure was picked (:attr:`FalloffAnalysis.note`).
 NO_DEPARTURE = "G dP/dG stays on its straight line through the origin"
-NO_LINE = "G dP/dG has no straight early part through the origin"
+NO_LINE = "G dP/dG has no straight early part through the origin and does not turn down"
 TOO_SHORT = "too few records after shut-in to pick closure"
 
 
@@ -162,7 +163,7 @@ def _pick(G, p, time, window, tolerance, skip, min_points, persist) -> tuple[Clo
     for i in range(start + min_points, n - persist + 1):
         m = float(np.median(ratio[start:i]))
         if not (math.isfinite(m) and m > 0.0) or np.any(np.abs(ratio[start:i] - m) > tolerance * m):
-            return None, NO_LINE
+            return _peak(G, p, time, derivative, start, tolerance, persist)
         off = (ratio[i:i + persist] - m) / m
         if np.all(off > tolerance) or np.all(off < -tolerance):
             k = i - 1
@@ -172,6 +173,21 @@ def _pick(G, p, time, window, tolerance, skip, min_points, persist) -> tuple[Clo
     return None, NO_DEPARTURE
 
 
+def _peak(G, p, time, derivative, start, tolerance, persist) -> tuple[ClosurePick | None, str]:  # noqa: N803
+    """The pick where G dP/dG has no straight early part (``closure_pick``): its largest value, followed by
+    ``persist`` records more than ``tolerance`` below it; (None, NO_LINE) when it never turns down so."""
+    best = start
+    for i in range(start, G.size):
+        if derivative[i] > derivative[best]:
+            best = i
+        below = derivative[i + 1:i + 1 + persist] < (1.0 - tolerance) * derivative[best]
+        if i == best and below.size == persist and np.all(below):
+            return ClosurePick(G=float(G[best]), pressure=float(p[best]),
+                               time=None if time is None else float(np.asarray(time)[best]), index=best,
+                               slope=math.nan, side="peak"), ""
+    return None, NO_LINE
+
+
 def closure_pick(G, p, time=None, window: float = DEFAULT_WINDOW, tolerance: float = DEFAULT_TOLERANCE,  # noqa: N803
                  skip: int = 2, min_points: int = 5, persist: int = 3) -> ClosurePick | None:
     """Closure by the tangent line (Barree et al. 2009): the line through the origin G dP/dG = m G with m the
@@ -179,8 +195,12 @@ def closure_pick(G, p, time=None, window: float = DEFAULT_WINDOW, tolerance: flo
     sure), which must all lie within ``tolerance`` x m of it (the early linear part); walking forward from the
     ``min_points``-th record, closure is the last record before the first one whose derivative leaves the line by
     more than ``tolerance`` x the line (above or below) with its next ``persist`` - 1 records off it on the same
-    side. None when the curve never leaves the line (not closed in the record), has no straight early part
-    (:data:`NO_LINE`), or the record is shorter than ``min_points`` + ``persist``."""
+    side. Where the early part is not straight (the fracture still extends after shut-in, so the curve bends from
+    the start), closure is where G dP/dG turns down: its largest value, followed by ``persist`` records more than
+    ``tolerance`` below it (side "peak", no slope: the stiffness-controlled decline ends there; our rule, for the
+    simulated fall-offs of fractures that grow after shut-in). None when the curve never leaves the line (not
+    closed in the record), bends and never turns down (:data:`NO_LINE`), or the record is shorter than
+    ``min_points`` + ``persist``."""
     return _pick(G, p, time, window, tolerance, skip, min_points, persist)[0]
 
 
