@@ -145,6 +145,9 @@ class ClosurePick:
     side: str
 
 
+#: The straight part must hold while G grows by at least this factor (a curve that bends everywhere is straight
+#: within the tolerance over a few close records).
+LINE_SPAN = 2.0
 #: Why no closure was picked (:attr:`FalloffAnalysis.note`).
 NO_DEPARTURE = "G dP/dG stays on its straight line through the origin"
 NO_LINE = "G dP/dG has no straight early part through the origin and does not turn down"
@@ -160,17 +163,22 @@ def _pick(G, p, time, window, tolerance, skip, min_points, persist) -> tuple[Clo
     start = min(skip, max(n - min_points - persist, 0))
     if n - start < min_points + persist:
         return None, TOO_SHORT
-    for i in range(start + min_points, n - persist + 1):
-        m = float(np.median(ratio[start:i]))
-        if not (math.isfinite(m) and m > 0.0) or np.any(np.abs(ratio[start:i] - m) > tolerance * m):
-            return _peak(G, p, time, derivative, start, tolerance, persist)
-        off = (ratio[i:i + persist] - m) / m
-        if np.all(off > tolerance) or np.all(off < -tolerance):
-            k = i - 1
-            return ClosurePick(G=float(G[k]), pressure=float(p[k]),
-                               time=None if time is None else float(np.asarray(time)[k]), index=k, slope=m,
-                               side="above" if off[0] > 0 else "below"), ""
-    return None, NO_DEPARTURE
+    for j in range(start, n - min_points - persist + 1):   # the straight part may follow an early transient
+        for i in range(j + min_points, n - persist + 1):
+            m = float(np.median(ratio[j:i]))
+            if not (math.isfinite(m) and m > 0.0) or np.any(np.abs(ratio[j:i] - m) > tolerance * m):
+                break
+            off = (ratio[i:i + persist] - m) / m
+            if G[i - 1] >= LINE_SPAN * G[j] and (np.all(off > tolerance) or np.all(off < -tolerance)):
+                k = i - 1
+                return ClosurePick(G=float(G[k]), pressure=float(p[k]),
+                                   time=None if time is None else float(np.asarray(time)[k]), index=k, slope=m,
+                                   side="above" if off[0] > 0 else "below"), ""
+        else:   # straight to the end of the record: a line, not closed; or too short a stretch for one
+            if G[-1] >= LINE_SPAN * G[j]:
+                return None, NO_DEPARTURE
+            break
+    return _peak(G, p, time, derivative, start, tolerance, persist)
 
 
 def _peak(G, p, time, derivative, start, tolerance, persist) -> tuple[ClosurePick | None, str]:  # noqa: N803
@@ -191,16 +199,17 @@ def _peak(G, p, time, derivative, start, tolerance, persist) -> tuple[ClosurePic
 def closure_pick(G, p, time=None, window: float = DEFAULT_WINDOW, tolerance: float = DEFAULT_TOLERANCE,  # noqa: N803
                  skip: int = 2, min_points: int = 5, persist: int = 3) -> ClosurePick | None:
     """Closure by the tangent line (Barree et al. 2009): the line through the origin G dP/dG = m G with m the
-    median of (G dP/dG) / G over the records so far (after the first ``skip``, whose derivative window is least
-    sure), which must all lie within ``tolerance`` x m of it (the early linear part); walking forward from the
-    ``min_points``-th record, closure is the last record before the first one whose derivative leaves the line by
-    more than ``tolerance`` x the line (above or below) with its next ``persist`` - 1 records off it on the same
-    side. Where the early part is not straight (the fracture still extends after shut-in, so the curve bends from
-    the start), closure is where G dP/dG turns down: its largest value, followed by ``persist`` records more than
-    ``tolerance`` below it (side "peak", no slope: the stiffness-controlled decline ends there; our rule, for the
-    simulated fall-offs of fractures that grow after shut-in). None when the curve never leaves the line (not
-    closed in the record), bends and never turns down (:data:`NO_LINE`), or the record is shorter than
-    ``min_points`` + ``persist``."""
+    median of (G dP/dG) / G over a run of at least ``min_points`` consecutive records that all lie within
+    ``tolerance`` x m of it while G grows by at least :data:`LINE_SPAN` (the straight part; it may start after
+    an early transient; the first ``skip`` records are never used, their derivative window being least sure);
+    closure is the last record of the run before one whose derivative leaves the line by more than ``tolerance``
+    x the line (above or below) with its next ``persist`` - 1 records off it on the same side. The earliest
+    such run is taken. Where no part is straight (the fracture still extends after shut-in, so the curve bends
+    from the start), closure is where G dP/dG turns down: its largest value, followed by ``persist`` records
+    more than ``tolerance`` below it (side "peak", no slope: the stiffness-controlled decline ends there; our
+    rule, for the simulated fall-offs of fractures that grow after shut-in). None when the curve stays on its
+    line (not closed in the record), bends and never turns down (:data:`NO_LINE`), or the record is shorter
+    than ``min_points`` + ``persist``."""
     return _pick(G, p, time, window, tolerance, skip, min_points, persist)[0]
 
 
