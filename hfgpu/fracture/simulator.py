@@ -298,7 +298,6 @@ class _Engine:
         g, sel = self.grid, (self.rows, self.cols)
         t_a, leaked_a = self.t, self.leaked_total
         self.t += dt
-        w_old = g["w"][sel]
         self.w_peak = max(self.w_peak, float(res.w.max()))
         shut_in = self.schedule.mean_rate(t_a, self.t) <= 0.0
         drained = shut_in & (res.w > 0.0) & (res.w < self.num.closure_width_fraction * self.w_peak) \

@@ -92,15 +92,16 @@ def treatment_pressures(balance: dict[str, np.ndarray], stop: float | None,
                         stp: np.ndarray | None = None) -> dict[str, float]:
     """From a fracture step history (``/fracture/balance``) and the time the pumps stop: the state at the end of
     pumping, the last record at or before ``stop`` (``pumping_time`` [s], ``pumping_area`` [m^2],
-    ``pumping_length``, ``pumping_height`` [m], ``pumping_net_pressure``, ``pumping_bhtp`` [Pa]), and ``isip`` [Pa], the BHTP of the first record after
-    ``stop``, at ``isip_time`` [s]. With ``stp``, the surface treating pressure of each record
-    (:func:`hfgpu.wellbore.surface_pressure`), also ``pumping_stp`` and ``isip_surface`` [Pa]. Empty when the
-    history has no record after ``stop`` (the run ended pumping, or no stop)."""
+    ``pumping_length``, ``pumping_height`` [m], ``pumping_net_pressure``, ``pumping_bhtp`` [Pa]), and ``isip``
+    [Pa], the BHTP of the first record after ``stop``, at ``isip_time`` [s]. With ``stp``, the surface treating
+    pressure of each record (:func:`hfgpu.wellbore.surface_pressure`), also ``pumping_stp`` and ``isip_surface``
+    [Pa]. Empty when the history has no record after ``stop`` (the run ended pumping, or no stop)."""
     time = np.asarray(balance.get("time", ()), dtype=np.float64)
     if stop is None or not time.size or time[-1] <= stop or time[0] > stop:
         return {}
     last = int(np.searchsorted(time, stop, side="right")) - 1
-    out = dict(pumping_time=time[last], pumping_area=balance["area"][last], pumping_length=balance["length"][last],
+    out = dict(pumping_time=time[last], pumping_area=balance["area"][last],
+               pumping_length=balance["length"][last],
                pumping_height=balance["height"][last], pumping_net_pressure=balance["net_pressure"][last],
                pumping_bhtp=balance["injection_pressure"][last], isip=balance["injection_pressure"][last + 1],
                isip_time=time[last + 1])

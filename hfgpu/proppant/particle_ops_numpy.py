@@ -24,9 +24,6 @@ from .interpolation import active_nodes, deposit, deposit_masks, interpolate
 from .params import MppicParams
 from .parcels import Parcels
 
-#: channels of the scattered per-cell sums, in order: kernels/layout.py MOMENT_FIELDS (M_VOLUME, ...)
-MOMENT_CHANNELS = MOMENT_FIELDS
-
 
 @dataclass(frozen=True)
 class CellMoments:
@@ -98,8 +95,8 @@ def check_fluid(width: np.ndarray, u: np.ndarray, v: np.ndarray, pressure: np.nd
 
 
 def moment_sums(parcels: Parcels, frame: GridFrame, width: np.ndarray) -> np.ndarray:
-    """Bilinear sums (MOMENT_COUNT, nz, nx) of the MOMENT_CHANNELS over parcels (numerators of Eq. 38 and of the
-    mass averages of O'Rourke & Snider 2010), channel M_VOLUME, M_MASS, ... (kernels/layout.py) by name."""
+    """Bilinear sums (MOMENT_COUNT, nz, nx) over parcels of the MOMENT_FIELDS (kernels/layout.py; numerators of
+    Eq. 38 and of the mass averages of O'Rourke & Snider 2010), each in its channel M_VOLUME, M_MASS, ... by name."""
     shape = check_width(width)
     cell_weight, _, _ = deposit_masks(width)
     k, i, w = weights(parcels.x, parcels.z, frame, "cell", cell_weight)

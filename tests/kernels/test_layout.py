@@ -61,7 +61,7 @@ def test_moment_channels_index_the_sums_by_name():
     expected = {"volume": vol, "mass": mass, "mass_u": mass * u, "mass_v": mass * v,
                 "mass_speed2": mass * (u ** 2 + v ** 2), "n_r3": particles * radius ** 3,
                 "n_r2": particles * radius ** 2}
-    assert set(expected) == set(L.MOMENT_FIELDS) and ref.MOMENT_CHANNELS == L.MOMENT_FIELDS
+    assert set(expected) == set(L.MOMENT_FIELDS)
     sums = ref.moment_sums(parcels, frame, width)
     assert sums.shape == (L.MOMENT_COUNT, *width.shape) == (len(MOMENT_CHANNELS), *width.shape)
     for constant, name in MOMENT_CHANNELS.items():
