@@ -23,6 +23,9 @@ from typing import Any, Iterable, Iterator
 from .errors import MISSING, SceneError
 from .units import FIELD_UNITS, SI_UNITS, has_dimension_of, to_si
 
+#: Characters of the allowed-key list an unknown-key error shows (:func:`key_list`).
+KEY_LIST_CHARS = 200
+
 _WARNINGS: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar("scene_warnings", default=None)
 _SYSTEM: contextvars.ContextVar[str] = contextvars.ContextVar("scene_system", default="SI")
 
@@ -181,7 +184,7 @@ class Table:
     def finish(self) -> None:
         """Raise on keys that were never read: they are typos or unsupported."""
         unknown = sorted(set(self.data) - self._read)
-        known = ", ".join(sorted(self._read)) or "(none)"
+        known = key_list(sorted(self._read))
         errors = []
         for key in unknown:
             near = closest(key, self._read)
@@ -189,6 +192,17 @@ class Table:
             errors.append(SceneError(self.key_path(key), self.data[key], f"unknown key; {hint}keys allowed here: "
                                      f"{known}"))
         raise_all(errors)
+
+
+def key_list(names: list[str], budget: int = KEY_LIST_CHARS) -> str:
+    """``names`` joined by commas; a list longer than ``budget`` characters is cut after the last name that fits
+    and says how many there are in all (an unknown-key error stays one readable line; docs/scene.md lists
+    every key)."""
+    text = ", ".join(names) or "(none)"
+    if len(text) <= budget:
+        return text
+    shown = text[:budget].rsplit(", ", 1)[0]
+    return f"{shown}, ... ({len(names)} keys; docs/scene.md)"
 
 
 def _bare_number(path: str, value: float, kind: str) -> None:

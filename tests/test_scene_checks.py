@@ -366,3 +366,14 @@ def test_pump_schedule_against_a_hand_computation():
     # 3 m^3/min = 18.87 bbl/min; 13.5 m^3 = 84.91 bbl; 3975 kg = 8763 lb; 294.4 kg/m^3 = 2.457 ppa, 662.5 = 5.529
     assert "rate [bbl/min]" in field[1] and "proppant [lb]" in field[1] and "conc. [ppa]" in field[1]
     assert "8 763" in field[3] and "2.457-5.529" in field[3] and "18.87" in field[2] and "84.91" in field[4]
+
+
+def test_an_unknown_key_in_a_long_table_lists_the_keys_in_one_short_line():
+    """[fracture] has 16 keys: the list is cut at KEY_LIST_CHARS characters and says how many there are."""
+    from hfgpu.scene_reader import KEY_LIST_CHARS, key_list
+
+    names = [f"key_{i:02d}_of_a_long_table" for i in range(16)]
+    text = key_list(names)
+    assert text.startswith("key_00_of_a_long_table, key_01") and text.endswith(", ... (16 keys; docs/scene.md)")
+    assert len(text) <= KEY_LIST_CHARS + len(", ... (16 keys; docs/scene.md)")
+    assert key_list(["a", "b"]) == "a, b" and key_list([]) == "(none)"
