@@ -1,5 +1,5 @@
 """The ``hfgpu`` command: run a scene, plot or export a results file, check a scene, run an
-ensemble of scenes, re-print a results file's summary (docs/cli.md).
+ensemble of scenes, re-print a results file's summary or read its fall-off (docs/cli.md).
 
 Exit codes: 0 success; 2 bad input or a failed run (an :class:`HfgpuError`, one line on stderr, no
 traceback; argparse usage errors and files or folders that cannot be written (OSError) too); 128 + the signal's number when interrupted: 130 Ctrl-C (SIGINT), 143
@@ -46,6 +46,12 @@ def _parser() -> argparse.ArgumentParser:
 
     summary = commands.add_parser("summary", help="print the run summary of a results file again")
     summary.add_argument("results", type=Path, help="results file (HDF5) written by 'hfgpu run'")
+
+    falloff = commands.add_parser("falloff", help="read the pressure fall-off after shut-in of a results file "
+                                  "with Nolte's G-function")
+    falloff.add_argument("results", type=Path, help="results file (HDF5) written by 'hfgpu run'")
+    falloff.add_argument("--alpha", type=float, default=None, help="area-growth exponent of G while pumping, "
+                         "0.5 to 1 (default 1; 0.5 low efficiency, 4/5 a toughness-dominated radial fracture)")
 
     check = commands.add_parser("check", help="validate a scene file and describe it")
     check.add_argument("scene", type=Path, help="scene file (TOML)")
@@ -137,6 +143,15 @@ def _summary(args: argparse.Namespace) -> None:
     print(summary(args.results), flush=True)
 
 
+def _falloff(args: argparse.Namespace) -> None:
+    from .io.summary import falloff_report
+
+    if args.alpha is not None and not 0.5 <= args.alpha <= 1.0:
+        raise HfgpuError(f"--alpha {args.alpha:g}: Nolte's G is defined for an area-growth exponent from 0.5 to 1")
+    _warn_unfinished(args.results)
+    print(falloff_report(args.results, args.alpha), flush=True)
+
+
 def _check(args: argparse.Namespace) -> None:
     """Validate as ``run`` does (:func:`hfgpu.scene_checks.validate`): warnings on stderr, then the description
     (cells in use, knobs, pump schedule) in the scene's output units on stdout."""
@@ -152,7 +167,7 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         {"run": _run, "plot": _plot, "check": _check, "export": _export, "sweep": _sweep,
-         "summary": _summary}[args.command](args)
+         "summary": _summary, "falloff": _falloff}[args.command](args)
     except HfgpuError as exc:  # one line per error (a scene's errors come together), even where a value holds breaks
         for error in getattr(exc, "errors", None) or [exc]:
             print(f"hfgpu {args.command}: error: {' '.join(str(error).splitlines())}", file=sys.stderr)

@@ -16,7 +16,13 @@ updates, is what the particle engine's speed multiplies (docs/benchmarks.md meas
 Closure after shut-in (``closure_after``): Nolte's (1979) relation between the efficiency at the end of pumping
 and the G-function at closure, eta = G_c / (4 g_0 / pi + G_c) (hfgpu.fracture.falloff, alpha = 1/2: Carter-
 dominated area growth, the bound that closes soonest), solved for the time after shut-in at which G(dt_D) = G_c:
-dt_c = t_p dt_D. None without leak-off (the fracture never closes).
+dt_c = t_p dt_D. None without leak-off (the fracture never closes). Nolte's relation holds the area at its
+value at shut-in. A fracture that keeps spreading after shut-in (a short, fast injection: a pulse) stops where
+the first of two things stops it: toughness, at the penny crack holding its volume V, R_K = (3 E' V / (8 sqrt(pi)
+K_Ic))^(2/5) (Sneddon 1946), or leak-off, at the viscous pulse's arrest radius R_a (Moeri & Lecampion 2022;
+hfgpu.reference.radial.leakoff_arrest_radius). Where that radius R_s is more than twice the radius at shut-in,
+the closure time is instead the time Carter's law takes to leak the volume stored at shut-in over that area
+(``closure_basis`` "arrest"): dt_c = (eta V / (2 C' pi R_s^2))^2.
 
 Warnings (:func:`warnings`):
 
@@ -56,7 +62,9 @@ class Estimate:
     """Scales of a run before it runs (SI): the radial fracture at the end of pumping (``radius`` R [m],
     ``efficiency``, ``opening`` w(0) [m]); the opening at the perforation when each proppant is first pumped
     (``first_openings``: name -> (time [s], w(0) [m])); ``cells`` of the fracture grid; ``proppant_steps``,
-    ``parcels`` (an upper bound, None when set per cell) and ``parcel_updates`` (None without both)."""
+    ``parcels`` (an upper bound, None when set per cell) and ``parcel_updates`` (None without both);
+    ``closure_after`` [s] after shut-in (None without leak-off) and its ``closure_basis``, "nolte" or "arrest"
+    (module docstring)."""
 
     pumping_time: float
     rate: float
@@ -66,6 +74,7 @@ class Estimate:
     first_openings: dict[str, tuple[float, float]]
     cells: float
     closure_after: float | None
+    closure_basis: str
     proppant_steps: int | None
     parcels: int | None
     parcel_updates: float | None
@@ -112,7 +121,13 @@ def estimate(scene: Any) -> Estimate | None:
         t_seen = max(t, 1e-3 * t_pump)  # sand from the first second: the opening a moment after it starts
         first[name] = (t, float(radial(t_seen).w0[-1]))
     cells = math.pi * radius**2 / (scene.mesh.dx * scene.mesh.dz)
-    closure = closure_after(float(end.efficiency[-1]), t_pump) if groups.C_prime > 0.0 else None
+    closure, basis = None, "nolte"
+    if groups.C_prime > 0.0:
+        closure = closure_after(float(end.efficiency[-1]), t_pump)
+        stops = arrest_radius(groups, volume)
+        if stops > 2.0 * radius:
+            closure = (float(end.efficiency[-1]) * volume / (2.0 * groups.C_prime * math.pi * stops**2)) ** 2
+            basis = "arrest"
     steps = parcels = updates = None
     if scene.proppant is not None and scene.coupling is not None and first:
         numerics = scene.proppant.numerics
@@ -125,8 +140,20 @@ def estimate(scene: Any) -> Estimate | None:
             updates = float(steps) * numerics.particle_substeps * parcels
     return Estimate(pumping_time=t_pump, rate=rate, radius=radius, efficiency=float(end.efficiency[-1]),
                     opening=float(end.w0[-1]), first_openings=first, cells=cells, closure_after=closure,
+                    closure_basis=basis,
                     proppant_steps=steps,
                     parcels=parcels, parcel_updates=updates)
+
+
+def arrest_radius(groups: Any, volume: float) -> float:
+    """Where a radial fracture holding ``volume`` [m^3] stops spreading after shut-in (module docstring): the
+    smaller of the penny crack's R_K (inf without toughness) and the leak-off arrest radius R_a (``groups``:
+    reference.radial.scaled_parameters, with leak-off)."""
+    from .reference.radial import leakoff_arrest_radius
+
+    k_ic = groups.K_prime / math.sqrt(32.0 / math.pi)
+    tough = (3.0 * groups.E_prime * volume / (8.0 * math.sqrt(math.pi) * k_ic)) ** 0.4 if k_ic > 0.0 else math.inf
+    return min(tough, leakoff_arrest_radius(groups.E_prime, groups.C_prime, volume, groups.mu_prime))
 
 
 def closure_after(efficiency: float, pumping_time: float) -> float:
@@ -159,8 +186,7 @@ def report(scene: Any, system: str) -> str:
              f"  {'fracture cells':32} ~{format_number(e.cells, 2)} (pi R^2 / cell area)"]
     if scene.run.end_time > e.pumping_time * (1.0 + 1e-9):
         closes = ("never (no leak-off)" if e.closure_after is None else
-                  f"about {display_text(e.closure_after, 'time', system, DIGITS)} after shut-in (Nolte's G at that "
-                  "efficiency)")
+                  f"about {display_text(e.closure_after, 'time', system, DIGITS)} after shut-in ({_basis(e)})")
         lines.append(f"  {'closure':32} {closes}")
     for name, (t, w0) in e.first_openings.items():
         lines.append(f"  {'opening when ' + name + ' starts':32} {display_text(w0, 'width', system, DIGITS)} "
@@ -172,6 +198,13 @@ def report(scene: Any, system: str) -> str:
                      "(docs/benchmarks.md: the engines' speed)")
         lines.append(f"  {'proppant steps':32} {work}")
     return "\n".join(lines)
+
+
+def _basis(e: Estimate) -> str:
+    """What ``e.closure_after`` rests on, in words."""
+    if e.closure_basis == "nolte":
+        return "Nolte's G at that efficiency"
+    return "Carter leak-off over the area where the fracture stops spreading after shut-in"
 
 
 def warnings(scene: Any, system: str) -> list[str]:
@@ -196,7 +229,7 @@ def warnings(scene: Any, system: str) -> list[str]:
     if shut_in > LONG_SHUT_IN * e.pumping_time:
         closes = ("it never closes without leak-off" if e.closure_after is None else
                   f"the fracture is expected to close about {display_text(e.closure_after, 'time', system, DIGITS)} "
-                  "after shut-in (Nolte's G)")
+                  f"after shut-in ({_basis(e)})")
         found.append(f"run.end_time: the shut-in lasts {shut_in / e.pumping_time:.2g} times the pumping time; "
                      f"{closes}")
     if scene.proppant is None:

@@ -141,6 +141,7 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     writer.close("complete", summary)
     closure = _write_closure(writer, scene) if scene.closure is not None else {}
     summary.update(closure)
+    summary.update(_write_falloff(writer, scene))
     if progress:  # in the output units; the file keeps SI
         if scene.injection is not None:
             print(schedule_table(scene, scene.output.units), flush=True)
@@ -158,6 +159,22 @@ def _checked(bar: Any, stop: Any) -> Callable[[float], None]:
 
     progress.phase, progress.note, progress.limit = bar.phase, bar.note, bar.limit  # type: ignore[attr-defined]
     return progress
+
+
+def _write_falloff(writer: Any, scene: Scene) -> dict[str, Any]:
+    """Read the fall-off of a complete run with a shut-in (hfgpu.io.summary.falloff_of) and add its
+    ``falloff_*`` values to ``/summary``; return those (none without a shut-in)."""
+    from .io.results import open_results
+    from .io.summary import falloff_of, falloff_values, pump_end
+
+    if not scene.has("fracture") or scene.injection is None:
+        return {}
+    analysis = falloff_of(open_results(writer.path).fracture_balance, pump_end(scene), scene.rock.plane_strain_modulus)
+    if analysis is None:
+        return {}
+    values = falloff_values(analysis)
+    writer.add_summary(values)
+    return values
 
 
 def _write_closure(writer: Any, scene: Scene) -> dict[str, Any]:

@@ -21,8 +21,6 @@ Warnings (the scene is valid, but likely not what was meant):
   on a face too): one warning per such boundary, naming the cell height that puts every boundary on a face;
 * what the fracture's closed-form scales predict (:mod:`hfgpu.estimate`): a grain too large for the expected
   opening at the perforation, a fracture of fewer than 3 cells' radius, leak-off taking nearly all the fluid;
-* ``[fracture] front_tracking = "subgrid"`` with a shut-in and leak-off: the sub-grid front's tip cells do not
-  close (simulator.py, "Closure"), so once the channel has drained its balance no longer holds;
 * fewer than :data:`MIN_CELLS_ACROSS` cells (dz in use) across a layer the fracture enters: the layer at the
   injection depth and the layers just above and below it (the outermost layers, which extend to +-infinity, are
   not counted).
@@ -80,22 +78,10 @@ def review(scene: Scene) -> list[str]:
                      "mesh.max_cells_across: the grid is never coarsened")
     if scene.injection is not None:
         found += _schedule(scene, system)
-        found += _subgrid_shut_in(scene)
     if scene.rock is not None and scene.rock.layers and scene.injection is not None and scene.has("fracture"):
         found += _layers(scene, system)
     found += expected_warnings(scene, system)
     return found
-
-
-def _subgrid_shut_in(scene: Scene) -> list[str]:
-    numerics, rock = scene.fracture, scene.rock
-    if numerics is None or numerics.front_tracking != "subgrid" or rock is None or not scene.has("fracture"):
-        return []
-    leaks = rock.leakoff_coefficient > 0.0 or any((layer.leakoff_coefficient or 0.0) > 0.0 for layer in rock.layers)
-    if scene.run.end_time <= scene.injection.schedule.pump_end or not leaks:
-        return []
-    return ['fracture.front_tracking "subgrid": after the shut-in its tip cells do not close, so once leak-off has '
-            'drained the fracture the volume balance no longer holds; "cells" closes the fracture']
 
 
 def _preset_coarsens(scene: Scene, system: str) -> list[str]:

@@ -215,7 +215,7 @@ DISPLAY_UNITS = {
     "pressure": ("MPa", "psi"), "volume": ("m**3", "bbl"), "solid_volume": ("m**3", "ft**3"),
     "mass": ("kg", "lb"), "rate": ("m**3/min", "bbl/min"), "concentration": ("kg/m**3", "ppa"),
     "viscosity": ("mPa*s", "cP"), "time": ("s", "s"), "density": ("kg/m**3", "lb/gal"),
-    "radius": ("um", "in"), "speed": ("m/s", "ft/s"),
+    "radius": ("um", "in"), "speed": ("m/s", "ft/s"), "leakoff": ("m/s**0.5", "ft/min**0.5"),
 }
 
 

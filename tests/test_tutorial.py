@@ -1,6 +1,6 @@
 """docs/tutorial.md works as written: its code blocks run in order in an empty folder (``toml`` blocks whose
-first line is ``# file: NAME`` are saved as NAME, each line of a ``bash`` block is run), and every figure it
-names is written."""
+first line is ``# file: NAME`` are saved as NAME, each line of a ``bash`` block is run), every figure it
+names is written, and the ``text`` block is what ``hfgpu falloff`` prints."""
 
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ def _command(line: str) -> list[str]:
 
 def test_tutorial_blocks_are_files_and_commands():
     found = blocks(TUTORIAL.read_text())
-    assert {language for language, _ in found} == {"toml", "bash"}
+    assert {language for language, _ in found} == {"toml", "bash", "text"}   # text: what a command prints
     assert all(body.startswith("# file: ") for language, body in found if language == "toml")
     assert sum(language == "bash" for language, _ in found) >= 4
 
@@ -46,6 +46,8 @@ def test_tutorial_runs(tmp_path):
             name = body.splitlines()[0].removeprefix("# file: ").strip()
             (tmp_path / name).write_text(body)
             continue
+        if language != "bash":
+            continue
         for line in body.splitlines():
             argv = _command(line)
             if not argv:
@@ -55,9 +57,12 @@ def test_tutorial_runs(tmp_path):
             assert "Traceback" not in done.stderr, done.stderr
             ran.append((line, done))
     assert len(ran) >= 7
-    runs = [done for line, done in ran if line.startswith("hfgpu run")]
+    runs = [done for line, done in ran if "slurry.h5" in line and line.startswith("hfgpu run")]
     assert "proppant" in runs[-1].stderr and "fracture" in runs[-1].stderr  # one bar per phase
     written = {p.name for p in tmp_path.rglob("*.png")}
     named = set(re.findall(r"`(\w+\.png)`", text))
     assert named and named <= written, named - written
     assert (tmp_path / "slurry.csv").is_file() and (tmp_path / "slurry.xml").is_file()
+    falloff = next(done for line, done in ran if line.startswith("hfgpu falloff"))
+    shown = next(body for language, body in blocks(text) if language == "text")
+    assert falloff.stdout.strip() == shown.strip()   # the tutorial shows what the command prints

@@ -41,9 +41,9 @@ class FractureNumerics:
     ribbon_fit: with the sub-grid front, how a ribbon cell's width places the front: "two_term" (the tip
         asymptote times a linear correction fitted through the ribbon and its inner neighbour) or "asymptote"
         (the asymptote's inverse alone); tip_cells.py has the equation and the measurements.
-    closure_width_fraction: a cell whose width falls over a step below this fraction of the largest width the
-        fracture has had is closed (simulator.py, "Closure"): its walls meet (contact, width 0) and the film
-        left in it leaks off with it.
+    closure_width_fraction: a cell whose width falls over a step without injection below this fraction of the
+        largest width the fracture has had, with Carter's demand over the step at least that width, is closed
+        (simulator.py, "Closure"): its walls meet (contact, width 0) and the film left in it leaks off with it.
     leakoff_clock: a cell whose leak-off the positivity ramp held below Carter's demand continues from the
         exposure time its leaked volume corresponds to (leakoff.carter_demand), so time spent dry does not
         count as exposure; off: Carter's law from the opening time, whatever the cell leaked.

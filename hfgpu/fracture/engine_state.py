@@ -14,15 +14,16 @@ from __future__ import annotations
 import numpy as np
 
 from .elasticity import ElasticityOperator
+from .front_cells import CellFront
 from .mesh import Grid
 
 #: Attributes (numbers or arrays) of the engine a checkpoint carries besides the grid.
 STATE_ATTRIBUTES = ("t", "t0", "v_front", "t_front", "leaked_total", "steps", "newton_iterations", "retries",
                     "coarsenings", "max_balance_error", "v_tip", "rejected", "dt_failed", "factorisations",
-                    "gmres_iterations", "w_peak", "t_closed")
+                    "gmres_iterations", "w_peak", "t_closed", "t_receding")
 #: Defaults of attributes added after files were written that lack them (the peak width: the grid's widths).
 LATER_ATTRIBUTES = {"w_peak": lambda state: float(np.max(state["grid"]["fields"]["w"], initial=0.0)),
-                    "t_closed": lambda state: float("nan")}
+                    "t_closed": lambda state: float("nan"), "t_receding": lambda state: float("nan")}
 
 
 def engine_state(engine) -> dict:
@@ -46,5 +47,7 @@ def restore_engine(engine, state: dict) -> None:
     engine.area = engine.dx * engine.dz
     engine.op = ElasticityOperator(engine.dx, engine.dz, engine.e_prime)
     engine.op.reserve(*(int(n) for n in state["elasticity_capacity"]))
+    if np.isfinite(engine.t_receding):   # a sub-grid front that has handed over to whole cells
+        engine.front_tracking = CellFront()
     engine.load_properties()
     engine.rebuild()

@@ -102,6 +102,17 @@ def fracture_stiffness(geometry: str, youngs_plane_strain: float, size: float) -
     return factors[geometry] * youngs_plane_strain / size
 
 
+def nolte_geometry(area: float, length: float, height: float) -> tuple[str, float]:
+    """(geometry, size) of :func:`fracture_stiffness` for a fracture of ``area`` [m^2] (one face), ``length`` (tip
+    to tip) and ``height`` [m] at shut-in: "pkn" (size: the height) when it is more than twice as long as high,
+    "kgd" (size: the half-length) when more than twice as high as long, else "radial" (size: sqrt(area / pi))."""
+    if length > 2.0 * height:
+        return "pkn", height
+    if height > 2.0 * length:
+        return "kgd", 0.5 * length
+    return "radial", math.sqrt(area / math.pi)
+
+
 def leakoff_coefficient(slope: float, t_p: float, stiffness: float, permeable_fraction: float = 1.0) -> float:
     """Apparent Carter coefficient C_L [m/s^0.5] from the G-slope m = -dp/dG [Pa], eq. (3):
     2 m / (pi r_p sqrt(t_p) S_f)."""
@@ -134,7 +145,8 @@ def superposition_derivative(G, p, window: float = DEFAULT_WINDOW) -> np.ndarray
 @dataclass(frozen=True)
 class ClosurePick:
     """Where G dP/dG leaves the line through the origin: closure's G, pressure [Pa], time [s] (None without
-    times), the index of the record, the line's slope m [Pa] (G dP/dG = m G while open; NaN for a "peak" pick)
+    times), the index of the record, the line's slope m [Pa] (G dP/dG = m G while open; for a "peak" pick the
+    line's through the origin and the pick, dP/dG at closure)
     and the side it left to ("below": the derivative falls under the line, normal closure; "above"; "peak": the
     curve had no straight early part and closure is where it turns down)."""
     G: float
@@ -192,7 +204,7 @@ def _peak(G, p, time, derivative, start, tolerance, persist) -> tuple[ClosurePic
         if i == best and below.size == persist and np.all(below):
             return ClosurePick(G=float(G[best]), pressure=float(p[best]),
                                time=None if time is None else float(np.asarray(time)[best]), index=best,
-                               slope=math.nan, side="peak"), ""
+                               slope=float(derivative[best] / G[best]), side="peak"), ""
     return None, NO_LINE
 
 
@@ -206,8 +218,9 @@ def closure_pick(G, p, time=None, window: float = DEFAULT_WINDOW, tolerance: flo
     x the line (above or below) with its next ``persist`` - 1 records off it on the same side. The earliest
     such run is taken. Where no part is straight (the fracture still extends after shut-in, so the curve bends
     from the start), closure is where G dP/dG turns down: its largest value, followed by ``persist`` records
-    more than ``tolerance`` below it (side "peak", no slope: the stiffness-controlled decline ends there; our
-    rule, for the simulated fall-offs of fractures that grow after shut-in). None when the curve stays on its
+    more than ``tolerance`` below it (side "peak", its slope the line's through the origin and the pick: the
+    stiffness-controlled decline ends there; our rule, for the simulated fall-offs of fractures that grow after
+    shut-in). None when the curve stays on its
     line (not closed in the record), bends and never turns down (:data:`NO_LINE`), or the record is shorter
     than ``min_points`` + ``persist``."""
     return _pick(G, p, time, window, tolerance, skip, min_points, persist)[0]
@@ -221,8 +234,9 @@ class FalloffAnalysis:
     open fracture's straight line (the closure pick's line; without closure, the whole record's when it stays on
     one, else NaN); ``closure``: the :class:`ClosurePick` or None; ``closure_time`` (after the stop),
     ``closure_pressure``, ``closure_net_pressure`` (less ``sigma_min``), ``G_c``, ``efficiency`` (eq. 4) are None
-    without closure; ``leakoff_coefficient`` [m/s^0.5] (eq. 3) only when a stiffness was given; ``note``: why no
-    closure was picked (:data:`NO_DEPARTURE`, :data:`NO_LINE`, :data:`TOO_SHORT`), empty with one."""
+    without closure; ``leakoff_coefficient`` [m/s^0.5] (eq. 3) only when a stiffness was given, ``geometry`` the
+    compliance it was read with (e.g. "radial, R = 7.1 m"; empty without); ``note``: why no closure was picked
+    (:data:`NO_DEPARTURE`, :data:`NO_LINE`, :data:`TOO_SHORT`), empty with one."""
     isip: float
     t_p: float
     sigma_min: float
@@ -242,15 +256,17 @@ class FalloffAnalysis:
     efficiency: float | None
     leakoff_coefficient: float | None
     note: str = ""
+    geometry: str = ""
 
 
 def falloff_analysis(time, bhp, t_pump_end: float, sigma_min: float, alpha: float = DEFAULT_ALPHA,
                      window: float = DEFAULT_WINDOW, tolerance: float = DEFAULT_TOLERANCE,
-                     stiffness: float | None = None, permeable_fraction: float = 1.0) -> FalloffAnalysis:
+                     stiffness: float | None = None, permeable_fraction: float = 1.0,
+                     geometry: str = "") -> FalloffAnalysis:
     """Read the fall-off of the bottom-hole pressure ``bhp`` [Pa] at ``time`` [s] (pumping from t = 0 to
     ``t_pump_end``) with G(alpha); ``sigma_min`` [Pa] the minimum stress at the injection depth; ``stiffness``
-    S_f [Pa/m] (:func:`fracture_stiffness`) for the leak-off coefficient. Raises ValueError when fewer than two
-    records follow the end of pumping."""
+    S_f [Pa/m] (:func:`fracture_stiffness`) for the leak-off coefficient, ``geometry`` what it is (kept as the
+    analysis's label). Raises ValueError when fewer than two records follow the end of pumping."""
     time, bhp = np.asarray(time, dtype=np.float64), np.asarray(bhp, dtype=np.float64)
     if not (t_pump_end is not None and math.isfinite(t_pump_end) and t_pump_end > 0.0):
         raise ValueError("no fall-off to analyse: the run has no end of pumping")
@@ -278,4 +294,4 @@ def falloff_analysis(time, bhp, t_pump_end: float, sigma_min: float, alpha: floa
                            closure_net_pressure=pick.pressure - sigma_min if closed else None,
                            G_c=pick.G if closed else None,
                            efficiency=efficiency_at_closure(pick.G, alpha) if closed else None,
-                           leakoff_coefficient=leakoff, note=note)
+                           leakoff_coefficient=leakoff, note=note, geometry=geometry if leakoff is not None else "")

@@ -13,6 +13,9 @@ channel once the step is accepted. This removes the whole-ring openings of the w
 leak-off dominated growth, starve the fracture after each opening. The time step follows the measured front
 advance (Eq. 35 with V_T = advance / dt).
 
+Closure. The pinned tip widths are a propagating front's; once a cell drains after shut-in the engine hands the
+front over to whole cells (simulator.py, "Closure").
+
 Coarsening. The 2x remeshing carries the front: a coarse cell it crosses is a tip cell wetted by the overlap
 mean of the fine fractions (coarsen.coarse_front; the coarse ribbons' s_0 is unknown until the next step places
 the front). A 3x3 merge makes every coarse cell a channel cell and the next step places the front again: a front

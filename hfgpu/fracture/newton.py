@@ -122,6 +122,7 @@ class StepResult:
     residual: np.ndarray      # final Eq. 29 residual per cell [m^3]
     work: NewtonWork          # the step's linear-algebra work (all contact passes)
     preconditioner: Any = None   # Newton-Krylov: the last preconditioner, for a next solve on the same cells
+    demand: np.ndarray | None = None   # Carter's demand per cell over the step [m^3] (leaked: its ramped part)
 
 
 class Elasticity:
@@ -397,4 +398,4 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
     r = residual(prob, elastic, x, closed)
     ok = converged and bool(np.all(np.isfinite(r.f)))
     return StepResult(w=r.w, p=r.p, leaked=prob.area * prob.demand * r.g, iterations=iterations, converged=ok,
-                      residual=r.f, work=work, preconditioner=preconditioner)
+                      residual=r.f, work=work, preconditioner=preconditioner, demand=prob.area * prob.demand)

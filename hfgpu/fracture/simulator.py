@@ -25,14 +25,20 @@ their opening times (at most 90 % of it), in the shape a uniform net pressure gi
 Closure. Carter leak-off drains a shut-in fracture; the positivity ramp (leakoff.available_fraction) keeps a
 draining cell's width above 0, so without a rule its walls would never meet. A cell whose width falls, over a
 step without injection, below ``closure_width_fraction`` of the largest width the fracture has had (``w_peak``)
-is closed at the end of that step (while pumping, the ramp alone governs starved cells): width 0, the film left
-in it added to the leak-off (Carter's law would take it within the step; the balance stays exact), and from
+while Carter's demand over the step is at least that width (the ramp held it back: the film would leak off
+within the step) is closed at the end of that step (while pumping, the ramp alone governs starved cells; a
+cell thinned by the fluid flowing on, as in a spreading pulse without leak-off, stays open): width 0, the film
+left in it added to the leak-off (the balance stays exact), and from
 then on it is a contact cell (newton.solve_step): it leaks no more, counts no area (geometry.py), passes
 pressure to closed neighbours through a residual aperture (newton.StepProblem.w_floor), and opens again when
 the fluid pressure exceeds the stress that holds it shut (a second injection: the perforated cell starts that
 step open). A fracture whose cells are all closed and that takes no injection has nothing to solve: its steps
 cost nothing and grow. ``t_closed`` is the time the last open cell closed (NaN while any cell is open); the
-summary reports it.
+summary reports it. A sub-grid front pins its tip cells to the asymptote of a propagating front (K_I = K_Ic), which
+a draining fracture's tip no longer is: they would hold their width with no fluid to feed them. So when the
+first cell of a sub-grid run drains, the front hands over to whole cells (``recede``, at ``t_receding``): every
+active cell becomes whole, its width (hence the volume) kept, and the contact set recedes it from then on,
+re-injection included.
 
 Coarsening. With ``mesh.max_cells_across`` set, the grid is coarsened by ``mesh.coarsening_factor`` (coarsen.py:
 3x3 merges, or PyFrac's 2x remeshing by area overlap; both centre a coarse cell on the injection cell) after a
@@ -72,6 +78,7 @@ from .config import FractureNumerics
 from .elasticity import ElasticityOperator
 from .engine_state import engine_state, restore_engine
 from .front import TipModel
+from .front_cells import CellFront
 from .front_strategy import front_strategy
 from .interpolate import StepEnds
 from .leakoff import carter_demand, carter_volume
@@ -194,6 +201,7 @@ class _Engine:
         self.dt_failed = math.inf   # the last step whose Newton failed, released step by step (next_dt)
         self.w_peak = float(g["w"].max())   # the largest width the fracture has had (closure)
         self.t_closed = math.nan            # when the last open cell closed (NaN while any is open)
+        self.t_receding = math.nan          # when a sub-grid front handed over to whole cells (closure)
         self.max_balance_error = 0.0
         self.ends: StepEnds | None = None   # the last step's two ends, when asked for (step's keep_ends)
         g["fill"][act] = 1.0
@@ -262,7 +270,7 @@ class _Engine:
             closed[self.inj] = False   # the injected fluid opens the perforated cell of a closed fracture
         if closed is not None and closed.all() and not source.any():   # a closed fracture: nothing moves
             zero = np.zeros(w_old.size)
-            return StepResult(w=zero, p=g["p"][sel].copy(), leaked=zero, iterations=0, converged=True,
+            return StepResult(w=zero, p=g["p"][sel].copy(), leaked=zero, demand=zero, iterations=0, converged=True,
                               residual=zero, work=NewtonWork())
         with blas_threads(self.ix.size):
             res = solve_step(prob, self.elastic, tolerance or self.num.newton_tolerance,
@@ -301,9 +309,11 @@ class _Engine:
         self.w_peak = max(self.w_peak, float(res.w.max()))
         shut_in = self.schedule.mean_rate(t_a, self.t) <= 0.0
         drained = shut_in & (res.w > 0.0) & (res.w < self.num.closure_width_fraction * self.w_peak) \
-            & (g["opened"][sel] < t_a)   # a cell opened at the step's start has one step to fill
+            & (res.demand >= res.w * self.area) & (g["opened"][sel] < t_a)   # one step to fill a new cell
         if pinned is not None:
             drained &= ~pinned
+            if drained.any():
+                self.recede()
         w = np.where(drained, 0.0, res.w)
         leaked = res.leaked + np.where(drained, res.w * self.area, 0.0)   # the film leaks off as the walls meet
         g["w"][sel] = w
@@ -321,6 +331,13 @@ class _Engine:
         self.steps += 1
         self.ends = None if start is None else StepEnds(t_a, self.t, start, g.copy(), leaked_a, self.leaked_total,
                                                         self.kprime_box, self.cprime_box)
+
+    def recede(self) -> None:
+        """Hand a sub-grid front over to whole cells (module docstring, "Closure"): every active cell whole
+        (its width kept, so the volume is), the contact set's from now on."""
+        self.front_tracking = CellFront()
+        self.grid["fill"][self.grid["active"]] = 1.0
+        self.t_receding = self.t
 
     def coarsen_if_wide(self) -> None:
         """Continue on a grid ``mesh.coarsening_factor`` times coarser (coarsen.coarse_grid: 3x3 merges, or
@@ -441,7 +458,7 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
             step = min(dt, remaining)
             if remaining - step < 1e-3 * step:
                 step = remaining
-            if step < MIN_STEP_FRACTION * target:
+            if step < MIN_STEP_FRACTION * eng.t:   # of the time reached, not of the next target (a long shut-in)
                 raise SimulationError(f"the time step fell to {step:.3g} s (below {MIN_STEP_FRACTION:g} of the "
                                       "time): the front keeps moving more than max_front_advance cells however "
                                       "short the step; raise [fracture] max_front_advance", time=eng.t)

@@ -457,6 +457,18 @@ class ResultsWriter:
         finally:
             release_lock(self.path)
 
+    def add_summary(self, values: dict[str, Any]) -> None:
+        """Add scalar ``values`` to ``/summary`` in one atomic edit (after :meth:`close`: post-processing of the
+        complete run, such as its fall-off)."""
+        def write(f: h5py.File) -> None:
+            f.require_group("summary").attrs.update(values)
+
+        acquire_lock(self.path)
+        try:
+            self._file.apply_last(write)
+        finally:
+            release_lock(self.path)
+
     def fail(self, message: str, summary: dict[str, Any] | None = None) -> None:
         """Close with status "failed: <message>"."""
         self.close(f"failed: {message}", summary)

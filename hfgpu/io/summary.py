@@ -71,6 +71,12 @@ def _count(value: Any) -> str | None:
     return format_number(float(int(value)), max(len(str(abs(int(value)))), 1)) if _finite(value) else None
 
 
+def _e_prime(scene: Any) -> float | None:
+    """The scene's plane-strain modulus E' [Pa] (None without a rock)."""
+    rock = getattr(scene, "rock", None)
+    return None if rock is None else rock.plane_strain_modulus
+
+
 def _when(value: Any, system: str = "SI") -> str:
     return _quantity(value, "time", system) if _finite(value) else "never"
 
@@ -110,12 +116,14 @@ def treatment_pressures(balance: dict[str, np.ndarray], stop: float | None,
     return {k: float(v) for k, v in out.items()}
 
 
-def falloff_of(balance: dict[str, np.ndarray] | None, stop: float | None):
+def falloff_of(balance: dict[str, np.ndarray] | None, stop: float | None, e_prime: float | None = None,
+               alpha: float | None = None):
     """The fall-off of a step history (``/fracture/balance``) after the pumps stop at ``stop`` [s], read with G
-    (:func:`hfgpu.fracture.falloff.falloff_analysis` on ``injection_pressure``; the minimum stress at the
-    injection depth is ``injection_pressure - net_pressure`` of the rows after the stop); None without at least
-    2 rows after ``stop``."""
-    from ..fracture.falloff import falloff_analysis
+    (:func:`hfgpu.fracture.falloff.falloff_analysis` on ``injection_pressure``, at ``alpha``, default the module's;
+    the minimum stress at the injection depth is ``injection_pressure - net_pressure`` of the rows after the stop);
+    with ``e_prime`` [Pa] also the apparent leak-off coefficient, read with the compliance of the footprint at the
+    end of pumping (:func:`hfgpu.fracture.falloff.nolte_geometry`); None without at least 2 rows after ``stop``."""
+    from ..fracture.falloff import DEFAULT_ALPHA, falloff_analysis, fracture_stiffness, nolte_geometry
 
     if not balance or stop is None or "injection_pressure" not in balance:
         return None
@@ -123,10 +131,31 @@ def falloff_of(balance: dict[str, np.ndarray] | None, stop: float | None):
     after = time > stop
     stress = bhp[after] - np.asarray(balance.get("net_pressure", np.full(time.shape, np.nan)), np.float64)[after]
     sigma_min = float(np.median(stress[np.isfinite(stress)])) if np.isfinite(stress).any() else math.nan
+    stiffness, geometry = None, ""
+    last = int(np.searchsorted(time, stop, side="right")) - 1
+    if e_prime is not None and last >= 0 and all(k in balance for k in ("area", "length", "height")):
+        shape, size = nolte_geometry(*(float(balance[k][last]) for k in ("area", "length", "height")))
+        if size > 0.0:
+            stiffness = fracture_stiffness(shape, e_prime, size)
+            geometry = f"{shape}, {'h_f' if shape == 'pkn' else 'x_f' if shape == 'kgd' else 'R'} = {size:.4g} m"
     try:
-        return falloff_analysis(time, bhp, stop, sigma_min)
+        return falloff_analysis(time, bhp, stop, sigma_min, alpha=DEFAULT_ALPHA if alpha is None else alpha,
+                                stiffness=stiffness, geometry=geometry)
     except ValueError:
         return None
+
+
+#: The ``/summary`` attributes of a fall-off (:func:`falloff_values`), SI; NaN where the analysis has none.
+FALLOFF_KEYS = ("isip", "sigma_min", "alpha", "closure_pressure", "closure_net_pressure", "closure_time", "G_c",
+                "efficiency", "slope", "leakoff_coefficient")
+
+
+def falloff_values(analysis: Any) -> dict[str, Any]:
+    """A :func:`falloff_of` analysis as ``/summary`` attributes: ``falloff_<key>`` for :data:`FALLOFF_KEYS`
+    (SI, NaN where it has none), ``falloff_geometry`` and ``falloff_note`` (strings, "" where it has none)."""
+    values = {f"falloff_{k}": math.nan if getattr(analysis, k) is None else float(getattr(analysis, k))
+              for k in FALLOFF_KEYS}
+    return {**values, "falloff_geometry": analysis.geometry, "falloff_note": analysis.note}
 
 
 def surface_history(balance: dict[str, np.ndarray] | None, scene: Any) -> np.ndarray | None:
@@ -180,13 +209,8 @@ def summary_rows(summary: dict[str, Any], system: str = "SI", density: float | N
         isip = _quantity(p["isip"], "pressure", system)
         add("end of pumping", "ISIP", f"{isip} (first record after, {_when(p['isip_time'], system)})" if isip else None)
         add("end of pumping", "ISIP at surface", _quantity(p.get("isip_surface"), "pressure", system))
-    if falloff is not None and falloff.closure is None:
-        add("fall-off", "closure", f"not picked: {falloff.note}")
-    elif falloff is not None:
-        add("fall-off", "closure pressure", _quantity(falloff.closure_pressure, "pressure", system))
-        add("fall-off", "closure time after shut-in", _when(falloff.closure_time, system))
-        add("fall-off", f"G at closure (alpha = {falloff.alpha:g})", format_number(falloff.G_c, 4))
-        add("fall-off", "efficiency at shut-in (Nolte, from G)", _percent(falloff.efficiency))
+    if falloff is not None:
+        rows += falloff_rows(falloff, system)
 
     add("fluid", "pumped", _quantity(s.get("injected_volume"), "volume", system))
     add("fluid", "in the fracture", _quantity(s.get("stored_volume"), "volume", system))
@@ -244,7 +268,51 @@ def summary_rows(summary: dict[str, Any], system: str = "SI", density: float | N
     return [(g, label, text) for g, label, text in rows if text is not None]
 
 
-def _table(rows: list[tuple[str, str, str]]) -> str:
+def falloff_rows(falloff: Any, system: str = "SI", isip: bool = False) -> list[tuple[str, str, str | None]]:
+    """The "fall-off" group's (group, label, text) rows of a :func:`falloff_of` analysis in ``system``'s units:
+    the closure picked (pressure, time after the stop, G_c, Nolte's efficiency) or why none was, and the apparent
+    leak-off coefficient when it has one; with ``isip`` first the ISIP and the minimum stress it is read against."""
+    rows: list[tuple[str, str, str | None]] = []
+
+    def add(label: str, text: str | None) -> None:
+        rows.append(("fall-off", label, text))
+
+    if isip:
+        add("ISIP (first record after the stop)", _quantity(falloff.isip, "pressure", system))
+        add("minimum stress at the injection depth", _quantity(falloff.sigma_min, "pressure", system))
+    if falloff.closure is None:
+        add("closure", f"not picked: {falloff.note}")
+    else:
+        add("closure pressure", _quantity(falloff.closure_pressure, "pressure", system))
+        add("closure time after shut-in", _when(falloff.closure_time, system))
+        add(f"G at closure (alpha = {falloff.alpha:g})", format_number(falloff.G_c, 4))
+        add("efficiency at shut-in (Nolte, from G)", _percent(falloff.efficiency))
+    if falloff.leakoff_coefficient is not None:
+        add(f"apparent leak-off coefficient ({falloff.geometry})",
+            _quantity(falloff.leakoff_coefficient, "leakoff", system))
+    return rows
+
+
+def falloff_report(path: Any, alpha: float | None = None) -> str:
+    """``hfgpu falloff``: the fall-off of the results file ``path`` (:func:`falloff_of`, G at ``alpha``) as a
+    table in its scene's units, with the ISIP. Raises HfgpuError, one line, for a run with no shut-in to read."""
+    from ..errors import HfgpuError
+    from .results import open_results
+
+    results = open_results(path)
+    scene, balance = results.scene, results.fracture_balance
+    stop = pump_end(scene)
+    if not balance or stop is None:
+        raise HfgpuError(f"{path}: no fall-off to analyse: the run has no fracture pressure history")
+    time = np.asarray(balance["time"], dtype=np.float64)
+    if np.count_nonzero(time > stop) < 2:
+        raise HfgpuError(f"{path}: no fall-off to analyse: the run has no shut-in (pumping until {stop:g} s, "
+                         f"records until {time[-1]:g} s); a shut-in is a last stage at rate 0")
+    analysis = falloff_of(balance, stop, _e_prime(scene), alpha)
+    return _table([row for row in falloff_rows(analysis, scene.output.units, isip=True) if row[2] is not None])
+
+
+def _table(rows: list[tuple[str, str, str | None]]) -> str:
     width = max((len(label) for _, label, _ in rows), default=0)
     lines, group = [], None
     for g, label, text in rows:
@@ -278,7 +346,7 @@ def summary_table(summary: dict[str, Any], system: str = "SI", scene: Any = None
     stp = surface_history(balance, scene)
     pressures = treatment_pressures(balance, pump_end(scene), stp) if balance and scene is not None else None
     stp_end = float(stp[-1]) if stp is not None and stp.size else None
-    falloff = falloff_of(balance, pump_end(scene)) if balance and scene is not None else None
+    falloff = falloff_of(balance, pump_end(scene), _e_prime(scene)) if balance and scene is not None else None
     return _table(summary_rows(summary, system, shared_density(scene), pressures, stp_end, falloff))
 
 

@@ -165,6 +165,19 @@ def mp_pulse_radius(E_prime, mu_prime, V0, t):
     return MP_RADIUS * (E * V**3 * t / mu) ** (1.0 / 9.0)
 
 
+ARREST_RADIUS = 0.521771773755632468   # the leak-off arrest radius coefficient, PyFrac's LeakOff_arrest
+
+
+def leakoff_arrest_radius(E_prime, C_prime, V0, mu_prime):
+    """Radius at which a viscosity-dominated pulse (toughness 0) of volume V0, injected in a time short against its
+    arrest, stops as Carter leak-off (C' = 2 C_L) takes its fluid: R_a = 0.521772 (E' V0^5 / (C'^2 mu'))^{1/13}
+    (PyFrac's HF_reference_solutions.LeakOff_arrest; Moeri & Lecampion 2022, "Arrest of a radial hydraulic
+    fracture upon shut-in of the injection", Int. J. Solids Struct.)."""
+    E, C, V, mu = (positive(n, v) for n, v in (("E_prime", E_prime), ("C_prime", C_prime), ("V0", V0),
+                                               ("mu_prime", mu_prime)))
+    return ARREST_RADIUS * (E * V**5 / (C**2 * mu)) ** (1.0 / 13.0)
+
+
 LEAKOFF_RADIUS = np.sqrt(2.0) / np.pi   # 0.4502
 MT_OPENING = 1.0493                     # Madyarova (2003) Omega(0): PyFrac's Mt_vertex_solution fit at rho = 0
 

@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import math
 
 import io_fakes as fakes
 import numpy as np
 import pytest
 
 from hfgpu import load_scene
-from hfgpu.fracture.falloff import G_function, efficiency_at_closure
+from hfgpu.fracture.falloff import G_function, efficiency_at_closure, fracture_stiffness, leakoff_coefficient
 from hfgpu.io.export import export
 from hfgpu.io.plots import FIGURE_NAMES, SHUT_IN_FIGURES, fall_off, figures, plot_results
 from hfgpu.io.results import ResultsWriter, open_results
@@ -91,6 +92,11 @@ def test_summary_has_the_fall_off_group(shut_in):
     assert "closure pressure  " in section and f"{format_number(a.closure_pressure * to)} {unit}" in section
     assert f"{format_number(a.closure_time)} s" in section
     assert "G at closure (alpha = 1)" in section and f"{format_number(100 * a.efficiency, 3)} %" in section
+    # the footprint at shut-in is 100 m^2, 3 m by 3 m: radial, R = sqrt(100 / pi)
+    stiffness = fracture_stiffness("radial", results.scene.rock.plane_strain_modulus, math.sqrt(100.0 / math.pi))
+    c_l = leakoff_coefficient(M, T_P, stiffness)
+    to, unit = (1.0, "m/s^0.5") if system == "SI" else (convert(1.0, "m/s**0.5", "ft/min**0.5"), "ft/min^0.5")
+    assert f"apparent leak-off coefficient (radial, R = 5.642 m)  {format_number(c_l * to)} {unit}" in section
 
 
 def test_csv_history_has_G_columns(shut_in, tmp_path):
