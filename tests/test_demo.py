@@ -97,3 +97,23 @@ def test_the_footprint_is_an_hour_glass_held_by_the_barriers(demo):
     assert length[neck].min() < length[pay].min() - 2 * frame.dx  # the lobes run ahead of the neck
     assert width[neck].max() < 0.8 * width[pay].max()  # the neck is narrower
     assert not np.any(width[barrier] > 0.0)  # at most one row into each barrier, none beyond
+
+
+def test_the_demos_fracture_closes_through_a_long_shut_in(tmp_path):
+    """demos/closure.py: the demo's fracture alone, shut in for 12 h, closes (docs/field-case.md, "Through
+    closure": 40 740 s), within a factor 2 of the Nolte estimate `hfgpu check` prints (55 800 s after shut-in);
+    the fall-off pick lies between the pay's and the perforated layer's stresses."""
+    import importlib.util
+
+    from hfgpu.io.summary import falloff_of, pump_end
+
+    spec = importlib.util.spec_from_file_location("closure_demo", DEMO.with_name("closure.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    scene = module.scene()
+    out = run(scene, tmp_path / "closure.h5", progress=False)
+    assert out["status"] == "complete" and out["area"] == 0.0
+    after = out["closed_at"] - pump_end(scene)
+    assert 55_800 / 2 < after < 2 * 55_800 and out["closed_at"] == pytest.approx(40_740, rel=0.05)
+    fall = falloff_of(open_results(tmp_path / "closure.h5").fracture_balance, pump_end(scene))
+    assert fall.closure is not None and 8700 * 6894.757 < fall.closure_pressure < 8950 * 6894.757

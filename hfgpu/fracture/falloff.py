@@ -194,14 +194,16 @@ def _pick(G, p, time, window, tolerance, skip, min_points, persist) -> tuple[Clo
 
 
 def _peak(G, p, time, derivative, start, tolerance, persist) -> tuple[ClosurePick | None, str]:  # noqa: N803
-    """The pick where G dP/dG has no straight early part (``closure_pick``): its largest value, followed by
-    ``persist`` records more than ``tolerance`` below it; (None, NO_LINE) when it never turns down so."""
-    best = start
-    for i in range(start, G.size):
+    """The pick where G dP/dG has no straight early part (``closure_pick``): its largest value so far, once
+    ``persist`` consecutive records after it lie more than ``tolerance`` below it (before any higher one);
+    (None, NO_LINE) when it never turns down so."""
+    best, below = start, 0
+    for i in range(start + 1, G.size):
         if derivative[i] > derivative[best]:
-            best = i
-        below = derivative[i + 1:i + 1 + persist] < (1.0 - tolerance) * derivative[best]
-        if i == best and below.size == persist and np.all(below):
+            best, below = i, 0
+            continue
+        below = below + 1 if derivative[i] < (1.0 - tolerance) * derivative[best] else 0
+        if below == persist:
             return ClosurePick(G=float(G[best]), pressure=float(p[best]),
                                time=None if time is None else float(np.asarray(time)[best]), index=best,
                                slope=float(derivative[best] / G[best]), side="peak"), ""
@@ -217,12 +219,12 @@ def closure_pick(G, p, time=None, window: float = DEFAULT_WINDOW, tolerance: flo
     closure is the last record of the run before one whose derivative leaves the line by more than ``tolerance``
     x the line (above or below) with its next ``persist`` - 1 records off it on the same side. The earliest
     such run is taken. Where no part is straight (the fracture still extends after shut-in, so the curve bends
-    from the start), closure is where G dP/dG turns down: its largest value, followed by ``persist`` records
-    more than ``tolerance`` below it (side "peak", its slope the line's through the origin and the pick: the
-    stiffness-controlled decline ends there; our rule, for the simulated fall-offs of fractures that grow after
-    shut-in). None when the curve stays on its
-    line (not closed in the record), bends and never turns down (:data:`NO_LINE`), or the record is shorter
-    than ``min_points`` + ``persist``."""
+    from the start), closure is where G dP/dG turns down: its largest value so far, once ``persist``
+    consecutive records after it lie more than ``tolerance`` below it (side "peak", its slope the line's
+    through the origin and the pick: the stiffness-controlled decline ends there; our rule, for the simulated
+    fall-offs of fractures that grow after shut-in). None when the curve stays on its line (not closed in the
+    record), bends and never turns down (:data:`NO_LINE`), or the record is shorter than ``min_points`` +
+    ``persist``."""
     return _pick(G, p, time, window, tolerance, skip, min_points, persist)[0]
 
 

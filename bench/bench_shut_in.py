@@ -1,0 +1,88 @@
+"""What a shut-in costs: a radial fracture pumped 20 s (0.01 m^3, Carter C_L 2e-6 m/s^0.5, 0.4 m cells: the case of
+issue 33) run to the end of pumping, and the same run followed by 5e4 s of shut-in, during which it drains and
+closes. Each run is timed inside one process (the fracture engine only: no process start, no results file), the
+two kinds interleaved, ``--repeats`` times each; the table gives the median wall seconds, the steps (before and
+after shut-in), when the fracture closed, and the ratio of the shut-in run to the injection alone (target: 2).
+
+    python bench/bench_shut_in.py [--repeats 3] [--fronts cells,subgrid]
+
+Asserts nothing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+SCENE = """
+[run]
+end_time = "{end}"
+physics = ["fracture"]
+
+[rock]
+youngs_modulus = "10 GPa"
+poisson_ratio = 0.25
+toughness = "0.5 MPa*m**0.5"
+leakoff_coefficient = "2e-6 m/s**0.5"
+min_stress = "6 MPa"
+
+[fluid]
+viscosity = "1e-3 Pa*s"
+
+[injection]
+depth = "1000 m"
+schedule = [{schedule}]
+
+[fracture]
+front_tracking = "{front}"
+
+[mesh]
+cell_size = "0.4 m"
+
+[output]
+every = "{end}"
+"""
+PUMP = '{ until = "20 s", rate = "5e-4 m**3/s" }'
+SHUT_IN = 5e4
+
+
+def run(front: str, shut_in: bool) -> tuple[float, dict, int]:
+    """(wall s, summary, steps after the pumps stop) of one run."""
+    from hfgpu.fracture.simulator import simulate
+    from hfgpu.records import MemorySink
+    from hfgpu.scene import load_scene
+
+    end = f"{20.0 + SHUT_IN:g} s" if shut_in else "20 s"
+    schedule = PUMP + (f', {{ until = "{end}", rate = "0 m**3/s" }}' if shut_in else "")
+    scene = load_scene(SCENE.format(end=end, schedule=schedule, front=front))
+    sink = MemorySink()
+    start = time.perf_counter()
+    out = simulate(scene, sink)
+    wall = time.perf_counter() - start
+    return wall, out, sum(r.time > 20.0 for r in sink.fracture_balances)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--fronts", default="cells,subgrid", help="any of cells,subgrid")
+    args = parser.parse_args()
+    run("cells", False)   # imports and first-call caches out of the timings
+    print(f"{'front':8} {'pumped s':>9} {'shut-in s':>10} {'ratio':>6} {'steps':>6} {'after':>6} {'closed at s':>12} "
+          f"{'balance':>8}")
+    for front in args.fronts.split(","):
+        walls: dict[bool, list[float]] = {False: [], True: []}
+        for _ in range(args.repeats):
+            for shut_in in (False, True):
+                wall, out, after = run(front, shut_in)
+                walls[shut_in].append(wall)
+                if shut_in:
+                    summary, steps_after = out, after
+        pumped, total = statistics.median(walls[False]), statistics.median(walls[True])
+        print(f"{front:8} {pumped:9.2f} {total:10.2f} {total / pumped:6.2f} {summary['steps']:6d} {steps_after:6d} "
+              f"{summary['closed_at']:12.0f} {summary['max_balance_error']:8.1e}")
+
+
+if __name__ == "__main__":
+    main()
