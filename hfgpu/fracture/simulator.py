@@ -33,8 +33,10 @@ then on it is a contact cell (newton.solve_step): it leaks no more, counts no ar
 pressure to closed neighbours through a residual aperture (newton.StepProblem.w_floor), and opens again when
 the fluid pressure exceeds the stress that holds it shut (a second injection: the perforated cell starts that
 step open). A fracture whose cells are all closed and that takes no injection has nothing to solve: its steps
-cost nothing and grow. ``t_closed`` is the time the last open cell closed (NaN while any cell is open); the
-summary reports it. A sub-grid front pins its tip cells to the asymptote of a propagating front (K_I = K_Ic), which
+cost nothing and grow. ``t_closed`` is the time the last open cell closed (NaN while any cell is open), the
+crossing of the threshold inside the step that closed it (``closing_time``, linear in time): a shut-in's steps
+grow to a good part of the time, and the step's end would report closure up to a step late; the summary reports
+it. A sub-grid front pins its tip cells to the asymptote of a propagating front (K_I = K_Ic), which
 a draining fracture's tip no longer is: they would hold their width with no fluid to feed them. So when the
 first cell of a sub-grid run drains, the front hands over to whole cells (``recede``, at ``t_receding``): every
 active cell becomes whole, its width (hence the volume) kept, and the contact set recedes it from then on,
@@ -314,6 +316,7 @@ class _Engine:
             drained &= ~pinned
             if drained.any():
                 self.recede()
+        w_start = g["w"][sel]
         w = np.where(drained, 0.0, res.w)
         leaked = res.leaked + np.where(drained, res.w * self.area, 0.0)   # the film leaks off as the walls meet
         g["w"][sel] = w
@@ -325,7 +328,9 @@ class _Engine:
         if np.any(w > 0.0):
             self.t_closed = math.nan
         elif math.isnan(self.t_closed):
-            self.t_closed = self.t
+            shut = (w_start > 0.0) & (w <= 0.0)   # drained, or squeezed shut by contact (width 0), in this step
+            self.t_closed = closing_time(t_a, dt, w_start[shut], np.maximum(res.w[shut], 0.0),
+                                         self.num.closure_width_fraction * self.w_peak)
         self.v_tip = advance / dt
         self.dt_failed *= FAILED_STEP_RELEASE
         self.steps += 1
@@ -402,6 +407,18 @@ class _Engine:
     def restore(self, state: dict) -> None:
         """Continue from a :meth:`state` (of a run of the same scene): same fields, same systems."""
         restore_engine(self, state)
+
+
+def closing_time(t_a: float, dt: float, w_start: np.ndarray, w_end: np.ndarray, threshold: float) -> float:
+    """When the last of the cells that closed over the step [t_a, t_a + dt] (drained, or squeezed shut by
+    contact: ``w_end`` 0) crossed the closure ``threshold`` width: the latest of the crossings of their widths,
+    linear in time from ``w_start`` to ``w_end`` (a cell already below it at the start crossed at t_a);
+    t_a + dt when none closed in the step."""
+    if w_start.size == 0:
+        return t_a + dt
+    drop = w_start - w_end
+    share = np.where(drop > 0.0, (w_start - threshold) / np.where(drop > 0.0, drop, 1.0), 1.0)
+    return t_a + dt * float(np.clip(share, 0.0, 1.0).max())
 
 
 def _times(scene, t0: float) -> tuple[list[float], list[float]]:

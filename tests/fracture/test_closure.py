@@ -153,7 +153,7 @@ def test_a_fall_off_asked_of_a_run_without_shut_in_says_so_in_one_line(tmp_path,
 def test_a_sub_grid_front_hands_over_to_whole_cells_and_closes(shut_in):
     """front_tracking = "subgrid": once the first cell drains the front recedes as whole cells (simulator.py,
     "Closure"); the fracture closes within 20 % of the whole-cell front's time, the balance stays exact, and a
-    checkpoint taken after the hand-over resumes with whole cells. Measured: 887 s against 1043 s."""
+    checkpoint taken after the hand-over resumes with whole cells. Measured: 873 s against 796 s."""
     from hfgpu.fracture.simulator import _Engine
 
     cells, _ = shut_in
