@@ -9,6 +9,10 @@ Radial (penny-shaped) active sets of N cells on a unit square grid. Prints two t
    (factorisation) time, iterations to a relative residual of 1e-10, solve time, and the error against
    the direct solution where there is one.
 
+3. planes (``--planes``): N parallel planes 10 cells apart, each with the same radial set of M cells, through
+   ``hfgpu.fracture.shadow.PlanesOperator.matvec`` (N forward FFTs, N^2 spectral products, N inverse) against
+   N^2 single-plane ``ElasticityOperator.matvec`` calls (what the product costs done block by block).
+
 Usage: ``python bench/bench_elasticity.py`` (N = 1e3 .. 3e4, about 20 s) or ``--full`` (adds N = 1e5
 and the dense LU at N = 1e4; about 1 minute). Everything runs on one thread (BLAS threads are set to 1
 unless OPENBLAS_NUM_THREADS / OMP_NUM_THREADS / MKL_NUM_THREADS are set; scipy.fft uses one worker), so
@@ -31,6 +35,7 @@ import numpy as np  # noqa: E402
 
 from hfgpu.fracture.elasticity import ElasticityOperator
 from hfgpu.fracture.krylov import elasticity_preconditioner, gmres_solve
+from hfgpu.fracture.shadow import PlanesOperator
 
 E_PRIME = 2.0e10
 RTOL = 1e-10
@@ -116,10 +121,31 @@ def solve_table(sizes, direct_max: int) -> None:
                   f"(limit N <= {direct_max})")
 
 
+def planes_table(cells: int, counts=(1, 2, 3, 5, 8)) -> None:
+    """Table 3 of the module docstring, at ``cells`` cells a plane."""
+    ix, iz = radial_cells(cells)
+    print(f"\n# planes: {ix.size} cells a plane, 10 cells apart; best of 3 (s)")
+    print(f"{'planes':>6} {'PlanesOperator':>15} {'N^2 single':>11} {'ratio':>6}")
+    single = ElasticityOperator(1.0, 1.0, E_PRIME)
+    w = np.random.default_rng(1).random(ix.size)
+    single.matvec(ix, iz, w)
+    for n in counts:
+        op = PlanesOperator(1.0, 1.0, E_PRIME, 10.0 * np.arange(n))
+        cells_n, w_n = [(ix, iz)] * n, [w] * n
+        op.matvec(cells_n, w_n)   # the kernel tables
+        _, fast, _ = timed(lambda: op.matvec(cells_n, w_n), repeats=3)
+        _, block, _ = timed(lambda: [single.matvec(ix, iz, w) for _ in range(n * n)], repeats=3)
+        print(f"{n:6d} {fast:15.4f} {block:11.4f} {block / fast:6.2f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--full", action="store_true", help="add N = 1e5 (and dense up to 1e4)")
+    parser.add_argument("--planes", type=int, metavar="M", help="only table 3, N planes of M cells each")
     args = parser.parse_args()
+    if args.planes:
+        planes_table(args.planes)
+        return
     sizes = [1_000, 3_000, 10_000, 30_000] + ([100_000] if args.full else [])
     threads = os.environ["OPENBLAS_NUM_THREADS"]
     print(f"# bench_elasticity ({'full' if args.full else 'default'}): numpy {np.__version__}, "
