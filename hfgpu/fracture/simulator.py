@@ -160,6 +160,7 @@ class _Engine:
         self.schedule = inj.schedule
         self.tip = TipModel(self.e_prime, self.mu_prime, numerics.tip_asymptote, numerics.tip_velocity)
         self.front_tracking = front_strategy(numerics.front_tracking)
+        self.pumping = True   # the run starts while pumping (start_time); step() follows the schedule
         self.op = ElasticityOperator(self.dx, self.dz, self.e_prime)
         h = max(self.dx, self.dz)
         r0 = numerics.initial_radius_cells * h
@@ -218,10 +219,12 @@ class _Engine:
         self.cprime_box = 2.0 * rock.leakoff_at(z)
 
     def rebuild(self) -> None:
-        """Systems of the current active set: indices, faces, C (dense or FFT), properties (after every change
-        of the active set; clears the cached front distances, views.distances)."""
+        """Systems of the current active set: indices, faces, C (dense or FFT; chosen for a stationary footprint
+        while the pumps are stopped, solver_choice.use_dense), properties (after every change of the active set
+        and when the pumps stop or start; clears the cached front distances, views.distances)."""
         self.rows, self.cols, self.ix, self.iz = self.grid.active_indices()
-        dense = use_dense(self.num.linear_solver, self.num.krylov_threshold, self.ix, self.iz)
+        dense = use_dense(self.num.linear_solver, self.num.krylov_threshold, self.ix, self.iz,
+                          stationary=not self.pumping)
         self.elastic = Elasticity(self.op, self.ix, self.iz, dense)
         self.faces = build_faces(self.ix, self.iz, self.dx, self.dz, self.mu_prime)
         sel = (self.rows, self.cols)
@@ -240,6 +243,9 @@ class _Engine:
         """Advance by dt with the front strategy (front_strategy.py); returns the step taken (shorter after a
         retry). With ``keep_ends`` the step's two ends are kept in ``ends`` (interpolate.StepEnds), else
         ``ends`` is None."""
+        if (self.schedule.rate(self.t) > 0.0) != self.pumping:   # the solver's choice changes at shut-in
+            self.pumping = not self.pumping
+            self.rebuild()
         return self.front_tracking.step(self, dt, keep_ends)
 
     def solve(self, dt: float, pinned: np.ndarray | None = None, w_start: np.ndarray | None = None,

@@ -4,7 +4,9 @@ Per active set (the engine's rebuild, simulator.py) "auto" picks the dense LU (n
 dense, scipy.linalg.lu_factor) or Newton-Krylov (GMRES with C applied by FFT over the footprint's bounding box,
 left-preconditioned by a SuperLU of the Jacobian with C cut to its near field, newton.NEAR_FIELD_RADIUS),
 whichever the model says is cheaper per Newton iteration. When the scene sets ``[fracture] krylov_threshold``
-the fixed count rule applies instead (dense below that many cells).
+the fixed count rule applies instead (dense below that many cells). After shut-in the footprint keeps its cells
+from step to step, so the dense path gathers C once for all the steps (``stationary``: the engine chooses again
+when the pumps stop or start).
 
 The model counts work from the footprint alone (deterministic: the same scene picks the same solvers on any
 machine), with constants in seconds measured on one core (bench/bench_solver.py --fit, elliptic footprints of
@@ -66,6 +68,7 @@ class CostModel:
     dense_factorisations: float = 2.2  # LU factorisations a step
     dense_extra: float = 7.0e-8        # n^2 work a step besides them: C gathered once per active set (~2.5e-8)
                                        # and ~8 chord iterations (a residual and an LU solve each)
+    dense_gather: float = 2.5e-8       # the gather's share of dense_extra, not paid by a stationary footprint
     krylov_factorisations: float = 1.4  # SuperLU factorisations a step (the preconditioner is reused)
     krylov_gmres: float = 44.0         # GMRES iterations a step (~6.2 Newton iterations of ~7 at rtol 1e-3)
 
@@ -96,14 +99,17 @@ class CostModel:
         """One Newton iteration with a new preconditioner and ``gmres_iterations`` GMRES iterations."""
         return self.factorisation_seconds(f) + self.gmres_iterations * self.gmres_seconds(f)
 
-    def dense_step_seconds(self, f: Footprint) -> float:
-        return self.dense_factorisations * self.dense_seconds(f) + self.dense_extra * f.n**2
+    def dense_step_seconds(self, f: Footprint, stationary: bool = False) -> float:
+        """A step's dense work; ``stationary``: on a footprint that keeps its cells from step to step (a shut-in),
+        which gathers C once for all its steps."""
+        extra = self.dense_extra - (self.dense_gather if stationary else 0.0)
+        return self.dense_factorisations * self.dense_seconds(f) + extra * f.n**2
 
     def krylov_step_seconds(self, f: Footprint) -> float:
         return self.krylov_factorisations * self.factorisation_seconds(f) + self.krylov_gmres * self.gmres_seconds(f)
 
-    def prefers_krylov(self, f: Footprint) -> bool:
-        return self.krylov_step_seconds(f) < self.dense_step_seconds(f)
+    def prefers_krylov(self, f: Footprint, stationary: bool = False) -> bool:
+        return self.krylov_step_seconds(f) < self.dense_step_seconds(f, stationary)
 
     @staticmethod
     def fit(rows) -> "CostModel":
@@ -122,11 +128,12 @@ class CostModel:
 MODEL = CostModel()
 
 
-def use_dense(solver: str, threshold: int | None, ix: np.ndarray, iz: np.ndarray) -> bool:
+def use_dense(solver: str, threshold: int | None, ix: np.ndarray, iz: np.ndarray, stationary: bool = False) -> bool:
     """Whether the active set (ix, iz) is solved with the dense LU: ``solver`` "direct" / "krylov" force it;
-    "auto" follows the fixed count rule when ``threshold`` is set (dense below it), else the cost model."""
+    "auto" follows the fixed count rule when ``threshold`` is set (dense below it), else the cost model
+    (``stationary``: the footprint keeps its cells, as after shut-in, CostModel.dense_step_seconds)."""
     if solver != "auto":
         return solver == "direct"
     if threshold is not None:
         return ix.size < threshold
-    return not MODEL.prefers_krylov(footprint_measures(ix, iz))
+    return not MODEL.prefers_krylov(footprint_measures(ix, iz), stationary)

@@ -42,6 +42,15 @@ def test_cost_model_prefers_dense_on_small_radial_and_krylov_on_elongated_footpr
     assert crossover(20.0) <= crossover(5.0) < crossover(1.0)
 
 
+def test_a_stationary_footprint_keeps_the_dense_lu_further():
+    """After shut-in the footprint keeps its cells, so the dense path gathers C once: the crossover to Krylov
+    moves up (bench/bench_shut_in.py: 357 radial cells, dense 9-11 ms a step against Krylov's 10-20 ms)."""
+    f = footprint_measures(*_ellipse(360, 1.0))
+    assert MODEL.prefers_krylov(f) and not MODEL.prefers_krylov(f, stationary=True)
+    assert MODEL.dense_step_seconds(f, stationary=True) == pytest.approx(
+        MODEL.dense_step_seconds(f) - MODEL.dense_gather * f.n**2, rel=1e-12)
+
+
 def test_krylov_threshold_is_optional_and_still_accepted():
     assert scene().fracture.krylov_threshold is None
     assert scene(fracture="[fracture]\nkrylov_threshold = 300").fracture.krylov_threshold == 300
