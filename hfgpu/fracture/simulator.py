@@ -28,12 +28,13 @@ step without injection, below ``closure_width_fraction`` of the largest width th
 while Carter's demand over the step is at least that width (the ramp held it back: the film would leak off
 within the step) is closed at the end of that step (while pumping, the ramp alone governs starved cells; a
 cell thinned by the fluid flowing on, as in a spreading pulse without leak-off, stays open): width 0, the film
-left in it added to the leak-off (the balance stays exact), and from
+left in it added to the leak-off (the balance stays exact; after shut-in a width the contact passes leave below
+0 within their tolerance is set to 0 the same way), and from
 then on it is a contact cell (newton.solve_step): it leaks no more, counts no area (geometry.py), passes
 pressure to closed neighbours through a residual aperture (newton.StepProblem.w_floor), and opens again when
 the fluid pressure exceeds the stress that holds it shut (a second injection: the perforated cell starts that
 step open). A fracture whose cells are all closed and that takes no injection has nothing to solve: its steps
-cost nothing and grow. ``t_closed`` is the time the last open cell closed (NaN while any cell is open), the
+cost a record each and grow (the fall-off's record goes on past closure, as a gauge's does). ``t_closed`` is the time the last open cell closed (NaN while any cell is open), the
 crossing of the threshold inside the step that closed it (``closing_time``, linear in time): a shut-in's steps
 grow to a good part of the time, and the step's end would report closure up to a step late; the summary reports
 it. A sub-grid front pins its tip cells to the asymptote of a propagating front (K_I = K_Ic), which
@@ -86,7 +87,7 @@ from .interpolate import StepEnds
 from .leakoff import carter_demand, carter_volume
 from .lubrication import build_faces
 from .mesh import GROW, Grid, injection_cell_centre
-from .newton import Elasticity, NewtonWork, StepProblem, StepResult, solve_step, start_widths
+from .newton import drained_start, Elasticity, NewtonWork, StepProblem, StepResult, solve_step, start_widths
 from .solver_choice import use_dense
 from .views import View, front_extents, geometry, snapshot
 
@@ -94,6 +95,8 @@ K_PRIME_FACTOR = math.sqrt(32.0 / math.pi)   # K' = sqrt(32/pi) K_Ic
 MIN_STEP_FRACTION = 1e-9   # a step shorter than this fraction of the time stops the run
 FAILED_STEP_MARGIN = 0.8     # the next steps stay below this fraction of the last step whose Newton failed ...
 FAILED_STEP_RELEASE = 1.02  # ... a bound that grows by this factor with every accepted step
+CLOSING_GROWTH = 1.0        # after a shut-in step in which cells closed, the next grows no more than this
+#                             (not < 1: cells may close over many steps; shrinking steps would meet MIN_STEP_FRACTION)
 
 
 def check_scene(scene) -> None:
@@ -202,6 +205,7 @@ class _Engine:
         self.factorisations = self.gmres_iterations = 0
         self.v_tip = 0.0
         self.dt_failed = math.inf   # the last step whose Newton failed, released step by step (next_dt)
+        self.closing = False        # cells closed in the last step: the next one does not grow (next_dt)
         self.w_peak = float(g["w"].max())   # the largest width the fracture has had (closure)
         self.t_closed = math.nan            # when the last open cell closed (NaN while any is open)
         self.t_receding = math.nan          # when a sub-grid front handed over to whole cells (closure)
@@ -219,9 +223,9 @@ class _Engine:
         self.cprime_box = 2.0 * rock.leakoff_at(z)
 
     def rebuild(self) -> None:
-        """Systems of the current active set: indices, faces, C (dense or FFT; chosen for a stationary footprint
-        while the pumps are stopped, solver_choice.use_dense), properties (after every change of the active set
-        and when the pumps stop or start; clears the cached front distances, views.distances)."""
+        """Systems of the current active set: indices, faces, C (dense or FFT, solver_choice.use_dense; while the
+        pumps are stopped, for a footprint expected to keep its cells), properties (after every change of the
+        active set, and when the pumps stop or start; clears the cached front distances, views.distances)."""
         self.rows, self.cols, self.ix, self.iz = self.grid.active_indices()
         dense = use_dense(self.num.linear_solver, self.num.krylov_threshold, self.ix, self.iz,
                           stationary=not self.pumping)
@@ -280,11 +284,13 @@ class _Engine:
             zero = np.zeros(w_old.size)
             return StepResult(w=zero, p=g["p"][sel].copy(), leaked=zero, demand=zero, iterations=0, converged=True,
                               residual=zero, work=NewtonWork())
+        if w_start is not None:
+            first = np.where(w_start > 0.0, w_start, start_widths(prob))
+        else:
+            first = drained_start(prob) if not source.any() and pinned is None else None
         with blas_threads(self.ix.size):
             res = solve_step(prob, self.elastic, tolerance or self.num.newton_tolerance,
-                             self.num.newton_max_iterations,
-                             None if w_start is None else np.where(w_start > 0.0, w_start, start_widths(prob)),
-                             closed, preconditioner, simplified_exit)
+                             self.num.newton_max_iterations, first, closed, preconditioner, simplified_exit)
         self.newton_iterations += res.iterations
         self.factorisations += res.work.factorisations
         self.gmres_iterations += res.work.gmres_iterations
@@ -323,14 +329,16 @@ class _Engine:
             if drained.any():
                 self.recede()
         w_start = g["w"][sel]
-        w = np.where(drained, 0.0, res.w)
-        leaked = res.leaked + np.where(drained, res.w * self.area, 0.0)   # the film leaks off as the walls meet
+        emptied = drained | (shut_in & (res.w < 0.0))   # and a width the contact passes left below 0
+        w = np.where(emptied, 0.0, res.w)
+        leaked = res.leaked + np.where(emptied, res.w * self.area, 0.0)   # the film leaks off as the walls meet
         g["w"][sel] = w
         g["p"][sel] = res.p
         self.distances = None
         g["leak_rate"][sel] = leaked / (self.area * dt)
         g["leaked"][sel] = g["leaked"][sel] + leaked / self.area
         self.leaked_total += float(leaked.sum())
+        self.closing = shut_in and bool(np.any((w_start > 0.0) & (w <= 0.0)))   # cells closed (next_dt)
         if np.any(w > 0.0):
             self.t_closed = math.nan
         elif math.isnan(self.t_closed):
@@ -378,8 +386,8 @@ class _Engine:
         if self.t > self.t_front:
             v = min(v, h / (self.t - self.t_front))
         v = max(v, self.v_tip, 1e-300)
-        return min(self.num.time_step_relaxation * h / v, self.num.max_step_growth * dt_prev,
-                   FAILED_STEP_MARGIN * self.dt_failed)
+        growth = min(CLOSING_GROWTH, self.num.max_step_growth) if self.closing else self.num.max_step_growth
+        return min(self.num.time_step_relaxation * h / v, growth * dt_prev, FAILED_STEP_MARGIN * self.dt_failed)
 
     # ------------------------------------------------------------------------------------------
     def balance(self) -> BalanceRecord:

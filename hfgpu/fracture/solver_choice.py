@@ -4,9 +4,10 @@ Per active set (the engine's rebuild, simulator.py) "auto" picks the dense LU (n
 dense, scipy.linalg.lu_factor) or Newton-Krylov (GMRES with C applied by FFT over the footprint's bounding box,
 left-preconditioned by a SuperLU of the Jacobian with C cut to its near field, newton.NEAR_FIELD_RADIUS),
 whichever the model says is cheaper per Newton iteration. When the scene sets ``[fracture] krylov_threshold``
-the fixed count rule applies instead (dense below that many cells). After shut-in the footprint keeps its cells
-from step to step, so the dense path gathers C once for all the steps (``stationary``: the engine chooses again
-when the pumps stop or start).
+the fixed count rule applies instead (dense below that many cells). After shut-in a draining footprint keeps its
+cells from step to step, so the dense path gathers C once for all the steps (``stationary``: the engine's choice
+while the pumps are stopped: the crossover to Krylov moves from 360 to 440 cells on a radial footprint, 290 to
+340 at aspect 20; a pulse that goes on spreading pays the gather again at each change in that range).
 
 The model counts work from the footprint alone (deterministic: the same scene picks the same solvers on any
 machine), with constants in seconds measured on one core (bench/bench_solver.py --fit, elliptic footprints of
