@@ -40,8 +40,8 @@ class CellFront:
         h = min(engine.dx, engine.dz)
         for attempt in range(engine.num.max_step_retries + 1):
             res = engine.solve(dt)
-            if res.converged:
-                advance = self._advance(engine, reach_old, res.w, res.p, engine.t + dt)
+            if res.converged:   # a closed fracture's front (no open cell) does not move
+                advance = self._advance(engine, reach_old, res.w, res.p, engine.t + dt) if res.w.any() else 0.0
                 if advance <= engine.num.max_front_advance * h or attempt == engine.num.max_step_retries:
                     break
                 engine.rejected += 1
@@ -51,7 +51,8 @@ class CellFront:
                 engine.newton_retry(dt)
             dt *= 0.5
         engine.accept(res, dt, advance, start)
-        self._open_cells(engine)
+        if engine.grid["w"].any():   # the front criterion needs an open cell to open its neighbours
+            self._open_cells(engine)
         return dt
 
     def filled_fraction(self, engine, view: View) -> np.ndarray:

@@ -267,6 +267,13 @@ class _Engine:
         wetted = None if pinned is None else np.where(np.isfinite(pinned), g["fill"][sel], 1.0)
         source = np.zeros(w_old.size)
         source[self.inj] = self.schedule.mean_rate(self.t, self.t + dt) * dt
+        closed = g.shut(self.t)[sel] if pinned is None else None   # the last step's contact set
+        if closed is not None and source[self.inj] > 0.0:
+            closed[self.inj] = False   # the injected fluid opens the perforated cell of a closed fracture
+        if closed is not None and closed.all() and not source.any():   # a closed fracture: nothing moves
+            zero = np.zeros(w_old.size)
+            return StepResult(w=zero, p=g["p"][sel].copy(), leaked=zero, demand=zero, iterations=0, converged=True,
+                              residual=zero, work=NewtonWork())
         if self.num.leakoff_clock:   # with a wetted fraction: the volume leaked per wetted area
             clock = leaked_old if wetted is None else np.divide(leaked_old, wetted, out=np.zeros_like(leaked_old),
                                                                 where=wetted > 0.0)
@@ -277,13 +284,6 @@ class _Engine:
         prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
                            demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted,
                            self.num.closure_width_fraction * self.w_peak)
-        closed = g.shut(self.t)[sel] if pinned is None else None   # the last step's contact set
-        if closed is not None and source[self.inj] > 0.0:
-            closed[self.inj] = False   # the injected fluid opens the perforated cell of a closed fracture
-        if closed is not None and closed.all() and not source.any():   # a closed fracture: nothing moves
-            zero = np.zeros(w_old.size)
-            return StepResult(w=zero, p=g["p"][sel].copy(), leaked=zero, demand=zero, iterations=0, converged=True,
-                              residual=zero, work=NewtonWork())
         if w_start is not None:
             first = np.where(w_start > 0.0, w_start, start_widths(prob))
         else:
