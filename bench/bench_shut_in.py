@@ -16,6 +16,8 @@ import argparse
 import statistics
 import time
 
+#: The case's scene (tests/fracture/test_closure.py runs it too): ``end`` and ``schedule`` as the run needs,
+#: ``c_l`` the Carter coefficient [m/s^0.5], ``fracture`` the lines of ``[fracture]``.
 SCENE = """
 [run]
 end_time = "{end}"
@@ -25,7 +27,7 @@ physics = ["fracture"]
 youngs_modulus = "10 GPa"
 poisson_ratio = 0.25
 toughness = "0.5 MPa*m**0.5"
-leakoff_coefficient = "2e-6 m/s**0.5"
+leakoff_coefficient = "{c_l} m/s**0.5"
 min_stress = "6 MPa"
 
 [fluid]
@@ -36,8 +38,7 @@ depth = "1000 m"
 schedule = [{schedule}]
 
 [fracture]
-front_tracking = "{front}"
-max_step_growth = {growth}
+{fracture}
 
 [mesh]
 cell_size = "0.4 m"
@@ -45,7 +46,8 @@ cell_size = "0.4 m"
 [output]
 every = "{end}"
 """
-PUMP = '{ until = "20 s", rate = "5e-4 m**3/s" }'
+C_L = 2e-6   # Carter coefficient [m/s^0.5]
+PUMP = '{ until = "20 s", rate = "5e-4 m**3/s" }'   # 0.01 m^3
 SHUT_IN = 5e4
 
 
@@ -57,7 +59,8 @@ def run(front: str, shut_in: bool, growth: float = 1.5) -> tuple[float, dict, in
 
     end = f"{20.0 + SHUT_IN:g} s" if shut_in else "20 s"
     schedule = PUMP + (f', {{ until = "{end}", rate = "0 m**3/s" }}' if shut_in else "")
-    scene = load_scene(SCENE.format(end=end, schedule=schedule, front=front, growth=growth))
+    scene = load_scene(SCENE.format(end=end, schedule=schedule, c_l=C_L,
+                                    fracture=f'front_tracking = "{front}"\nmax_step_growth = {growth}'))
     sink = MemorySink()
     start = time.perf_counter()
     out = simulate(scene, sink)

@@ -123,11 +123,12 @@ def estimate(scene: Any) -> Estimate | None:
     cells = math.pi * radius**2 / (scene.mesh.dx * scene.mesh.dz)
     closure, basis = None, "nolte"
     if groups.C_prime > 0.0:
-        closure = closure_after(float(end.efficiency[-1]), t_pump)
         stops = arrest_radius(groups, volume)
         if stops > 2.0 * radius:
             closure = (float(end.efficiency[-1]) * volume / (2.0 * groups.C_prime * math.pi * stops**2)) ** 2
             basis = "arrest"
+        else:
+            closure = closure_after(float(end.efficiency[-1]), t_pump)
     steps = parcels = updates = None
     if scene.proppant is not None and scene.coupling is not None and first:
         numerics = scene.proppant.numerics
@@ -149,10 +150,11 @@ def arrest_radius(groups: Any, volume: float) -> float:
     """Where a radial fracture holding ``volume`` [m^3] stops spreading after shut-in (module docstring): the
     smaller of the penny crack's R_K (inf without toughness) and the leak-off arrest radius R_a (``groups``:
     reference.radial.scaled_parameters, with leak-off)."""
+    from .reference.penny import penny_arrest_radius
     from .reference.radial import leakoff_arrest_radius
 
     k_ic = groups.K_prime / math.sqrt(32.0 / math.pi)
-    tough = (3.0 * groups.E_prime * volume / (8.0 * math.sqrt(math.pi) * k_ic)) ** 0.4 if k_ic > 0.0 else math.inf
+    tough = penny_arrest_radius(groups.E_prime, k_ic, volume) if k_ic > 0.0 else math.inf
     return min(tough, leakoff_arrest_radius(groups.E_prime, groups.C_prime, volume, groups.mu_prime))
 
 

@@ -65,6 +65,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg
 import scipy.sparse
+from scipy.optimize import brentq
 from scipy.sparse.linalg import LinearOperator
 
 from .elasticity import ElasticityOperator
@@ -369,8 +370,6 @@ def drained_start(prob: StepProblem) -> np.ndarray:
     the open cells lose equals what they leak, sum (1 - s) w_old = sum demand g(s w_old) (the shape kept, as a
     uniformly falling net pressure keeps it). From w_old itself, the long steps of a fracture near closure,
     whose cells lose most of their fluid in a step, took 20 damped Newton iterations."""
-    from scipy.optimize import brentq
-
     w0 = np.maximum(prob.w_old, 0.0)
     share = 1.0 if prob.wetted is None else prob.wetted
 

@@ -29,19 +29,20 @@ while Carter's demand over the step is at least that width (the ramp held it bac
 within the step) is closed at the end of that step (while pumping, the ramp alone governs starved cells; a
 cell thinned by the fluid flowing on, as in a spreading pulse without leak-off, stays open): width 0, the film
 left in it added to the leak-off (the balance stays exact; after shut-in a width the contact passes leave below
-0 within their tolerance is set to 0 the same way), and from
-then on it is a contact cell (newton.solve_step): it leaks no more, counts no area (geometry.py), passes
-pressure to closed neighbours through a residual aperture (newton.StepProblem.w_floor), and opens again when
-the fluid pressure exceeds the stress that holds it shut (a second injection: the perforated cell starts that
-step open). A fracture whose cells are all closed and that takes no injection has nothing to solve: its steps
-cost a record each and grow (the fall-off's record goes on past closure, as a gauge's does). ``t_closed`` is the time the last open cell closed (NaN while any cell is open), the
-crossing of the threshold inside the step that closed it (``closing_time``, linear in time): a shut-in's steps
-grow to a good part of the time, and the step's end would report closure up to a step late; the summary reports
-it. A sub-grid front pins its tip cells to the asymptote of a propagating front (K_I = K_Ic), which
-a draining fracture's tip no longer is: they would hold their width with no fluid to feed them. So when the
-first cell of a sub-grid run drains, the front hands over to whole cells (``recede``, at ``t_receding``): every
-active cell becomes whole, its width (hence the volume) kept, and the contact set recedes it from then on,
-re-injection included.
+0 within their tolerance is set to 0 the same way), and from then on it is a contact cell (newton.solve_step):
+it leaks no more, counts no area (geometry.py), passes pressure to closed neighbours through a residual aperture
+(newton.StepProblem.w_floor), and opens again when the fluid pressure exceeds the stress that holds it shut (a
+second injection: the perforated cell starts that step open). A shut-in step in which cells closed is not
+followed by a longer one (CLOSING_GROWTH), and Newton starts a step without injection from the drained widths
+(newton.drained_start). A fracture whose cells are all closed and that takes no injection has nothing to solve:
+its steps cost a record each and grow (the fall-off's record goes on past closure, as a gauge's does).
+``t_closed`` is the time the last open cell closed (NaN while any cell is open), the crossing of the threshold
+inside the step that closed it (``closing_time``, linear in time): a shut-in's steps grow to a good part of the
+time, and the step's end would report closure up to a step late; the summary reports it. A sub-grid front pins
+its tip cells to the asymptote of a propagating front (K_I = K_Ic), which a draining fracture's tip no longer is:
+they would hold their width with no fluid to feed them. So when the first cell of a sub-grid run drains, the
+front hands over to whole cells (``recede``, at ``t_receding``): every active cell becomes whole, its width
+(hence the volume) kept, and the contact set recedes it from then on, re-injection included.
 
 Coarsening. With ``mesh.max_cells_across`` set, the grid is coarsened by ``mesh.coarsening_factor`` (coarsen.py:
 3x3 merges, or PyFrac's 2x remeshing by area overlap; both centre a coarse cell on the injection cell) after a
@@ -282,8 +283,7 @@ class _Engine:
             demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt, filled)
         w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
         prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
-                           demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted,
-                           self.num.closure_width_fraction * self.w_peak)
+                           demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted, self.closure_width)
         if w_start is not None:
             first = np.where(w_start > 0.0, w_start, start_widths(prob))
         else:
@@ -322,7 +322,7 @@ class _Engine:
         self.t += dt
         self.w_peak = max(self.w_peak, float(res.w.max()))
         shut_in = self.schedule.mean_rate(t_a, self.t) <= 0.0
-        drained = shut_in & (res.w > 0.0) & (res.w < self.num.closure_width_fraction * self.w_peak) \
+        drained = shut_in & (res.w > 0.0) & (res.w < self.closure_width) \
             & (res.demand >= res.w * self.area) & (g["opened"][sel] < t_a)   # one step to fill a new cell
         if pinned is not None:
             drained &= ~pinned
@@ -338,18 +338,22 @@ class _Engine:
         g["leak_rate"][sel] = leaked / (self.area * dt)
         g["leaked"][sel] = g["leaked"][sel] + leaked / self.area
         self.leaked_total += float(leaked.sum())
-        self.closing = shut_in and bool(np.any((w_start > 0.0) & (w <= 0.0)))   # cells closed (next_dt)
+        shut = (w_start > 0.0) & (w <= 0.0)   # drained, or squeezed shut by contact (width 0), in this step
+        self.closing = shut_in and bool(shut.any())   # next_dt
         if np.any(w > 0.0):
             self.t_closed = math.nan
         elif math.isnan(self.t_closed):
-            shut = (w_start > 0.0) & (w <= 0.0)   # drained, or squeezed shut by contact (width 0), in this step
-            self.t_closed = closing_time(t_a, dt, w_start[shut], np.maximum(res.w[shut], 0.0),
-                                         self.num.closure_width_fraction * self.w_peak)
+            self.t_closed = closing_time(t_a, dt, w_start[shut], np.maximum(res.w[shut], 0.0), self.closure_width)
         self.v_tip = advance / dt
         self.dt_failed *= FAILED_STEP_RELEASE
         self.steps += 1
         self.ends = None if start is None else StepEnds(t_a, self.t, start, g.copy(), leaked_a, self.leaked_total,
                                                         self.kprime_box, self.cprime_box)
+
+    @property
+    def closure_width(self) -> float:
+        """The width below which a draining cell closes: ``closure_width_fraction`` x ``w_peak`` [m]."""
+        return self.num.closure_width_fraction * self.w_peak
 
     def recede(self) -> None:
         """Hand a sub-grid front over to whole cells (module docstring, "Closure"): every active cell whole

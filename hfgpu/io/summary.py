@@ -304,11 +304,10 @@ def falloff_report(path: Any, alpha: float | None = None) -> str:
     stop = pump_end(scene)
     if not balance or stop is None:
         raise HfgpuError(f"{path}: no fall-off to analyse: the run has no fracture pressure history")
-    time = np.asarray(balance["time"], dtype=np.float64)
-    if np.count_nonzero(time > stop) < 2:
-        raise HfgpuError(f"{path}: no fall-off to analyse: the run has no shut-in (pumping until {stop:g} s, "
-                         f"records until {time[-1]:g} s); a shut-in is a last stage at rate 0")
     analysis = falloff_of(balance, stop, _e_prime(scene), alpha)
+    if analysis is None:   # fewer than 2 records after the stop
+        raise HfgpuError(f"{path}: no fall-off to analyse: the run has no shut-in (pumping until {stop:g} s, "
+                         f"records until {balance['time'][-1]:g} s); a shut-in is a last stage at rate 0")
     return _table([row for row in falloff_rows(analysis, scene.output.units, isip=True) if row[2] is not None])
 
 

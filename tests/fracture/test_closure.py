@@ -3,6 +3,8 @@ its wetted footprint recedes to nothing, the run completes with steps that grow 
 second injection opens it again; the volume balance holds throughout."""
 
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,38 +14,14 @@ from hfgpu.fracture.simulator import simulate
 from hfgpu.records import MemorySink
 from hfgpu.scene import load_scene
 
-C_L = 2e-6   # Carter coefficient [m/s^0.5]
-SCENE = """
-[run]
-end_time = "{end}"
-physics = ["fracture"]
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 
-[rock]
-youngs_modulus = "10 GPa"
-poisson_ratio = 0.25
-toughness = "0.5 MPa*m**0.5"
-leakoff_coefficient = "{c_l} m/s**0.5"
-min_stress = "6 MPa"
-
-[fluid]
-viscosity = "1e-3 Pa*s"
-
-[injection]
-depth = "1000 m"
-schedule = [{schedule}]
-
-[mesh]
-cell_size = "0.4 m"
-
-[output]
-every = "{end}"
-"""
-PUMP = '{ until = "20 s", rate = "5e-4 m**3/s" }'   # 0.01 m^3
+from bench_shut_in import C_L, PUMP, SCENE  # noqa: E402   the benchmark's case (bench/bench_shut_in.py)
 
 
 def run(schedule: str, end: str, c_l: float = C_L):
     sink = MemorySink()
-    out = simulate(load_scene(SCENE.format(end=end, c_l=c_l, schedule=schedule)), sink)
+    out = simulate(load_scene(SCENE.format(end=end, c_l=c_l, schedule=schedule, fracture="")), sink)
     rows = sink.fracture_balances
     return out, {k: np.array([getattr(r, k) for r in rows]) for k in ("time", "injected", "stored", "leaked",
                                                                        "area")}
@@ -139,7 +117,7 @@ def test_a_fall_off_asked_of_a_run_without_shut_in_says_so_in_one_line(tmp_path,
     import hfgpu
     from hfgpu.cli import main
 
-    text = SCENE.format(end="20 s", c_l=C_L, schedule=PUMP)
+    text = SCENE.format(end="20 s", c_l=C_L, schedule=PUMP, fracture="")
     (tmp_path / "pump.toml").write_text(text)
     out = hfgpu.run(tmp_path / "pump.toml", tmp_path / "pump.h5", progress=False)
     assert not any(key.startswith("falloff_") for key in out)
@@ -157,8 +135,8 @@ def test_a_sub_grid_front_hands_over_to_whole_cells_and_closes():
     whole-cell front's 721 s (606 s at steps growing 1.05x: docs/benchmarks.md)."""
     from hfgpu.fracture.simulator import _Engine
 
-    text = SCENE.format(end="3000 s", c_l=C_L, schedule=PUMP + ', { until = "3000 s", rate = "0 m**3/s" }')
-    scene = load_scene(text.replace("[mesh]", '[fracture]\nfront_tracking = "subgrid"\n\n[mesh]'))
+    scene = load_scene(SCENE.format(end="3000 s", c_l=C_L, schedule=PUMP + ', { until = "3000 s", rate = "0 m**3/s" }',
+                                    fracture='front_tracking = "subgrid"'))
     sink = MemorySink()
     out = simulate(scene, sink)
     bound = (0.01 / (4.0 * C_L * max(r.area for r in sink.fracture_balances))) ** 2
@@ -248,6 +226,8 @@ def test_without_leak_off_a_tough_fracture_arrests_at_the_penny_crack_radius():
     the front's mean +0.94 %."""
     from importlib.resources import files
 
+    from hfgpu.reference.penny import penny_arrest_radius
+
     text = (files("hfgpu") / "scenes" / "radial_III.toml").read_text()
     text = (text.replace('end_time = "405.8 s"', 'end_time = "4000 s"')
             .replace('schedule = [{ until = "405.8 s", rate = "3e-5 m**3/s" }]',
@@ -257,7 +237,7 @@ def test_without_leak_off_a_tough_fracture_arrests_at_the_penny_crack_radius():
     scene = load_scene(text)
     sink = MemorySink()
     out = simulate(scene, sink)
-    arrest = (3.0 * scene.rock.plane_strain_modulus * 3e-3 / (8.0 * math.sqrt(math.pi) * scene.rock.toughness)) ** 0.4
+    arrest = penny_arrest_radius(scene.rock.plane_strain_modulus, scene.rock.toughness, 3e-3)
     assert out["area_radius"] == pytest.approx(arrest, rel=0.02) and out["radius"] == pytest.approx(arrest, rel=0.02)
     largest = math.sqrt(max(b.area for b in sink.fracture_balances) / math.pi)
     assert largest < 1.02 * arrest and math.isnan(out["closed_at"])

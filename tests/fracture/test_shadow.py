@@ -9,7 +9,7 @@ import pytest
 
 from hfgpu.fracture.elasticity import ElasticityOperator, influence
 from hfgpu.fracture.shadow import PlanesOperator, _corner, offset_influence
-from hfgpu.reference.penny import penny_axis_stress, penny_opening
+from hfgpu.reference.penny import penny_arrest_radius, penny_axis_stress, penny_opening
 
 
 def test_the_closed_form_gives_the_published_numbers():
@@ -73,3 +73,14 @@ def test_n_planes_by_fft_equal_the_dense_sum():
     single = PlanesOperator(0.6, 0.4, 2e10, [1.0]).matvec(cells[:1], w[:1])[0]
     np.testing.assert_allclose(single, ElasticityOperator(0.6, 0.4, 2e10).matvec(*cells[0], w[0]), rtol=1e-12,
                                atol=1e-12 * np.abs(single).max())
+
+
+def test_the_arrest_radius_holds_its_volume_at_the_toughness():
+    """penny_arrest_radius: the crack of that radius at the pressure giving K_I = 2 p sqrt(a / pi) = K_Ic holds
+    the volume asked for (Sneddon's opening integrated over the disc)."""
+    e_prime, k_ic, volume = 2e10, 1e6, 3e-3
+    a = penny_arrest_radius(e_prime, k_ic, volume)
+    p = k_ic / (2.0 * np.sqrt(a / np.pi))
+    r = np.linspace(0.0, a, 200_001)
+    held = np.trapezoid(2.0 * np.pi * r * penny_opening(r, a, p, e_prime), r)
+    assert held == pytest.approx(volume, rel=1e-6)
