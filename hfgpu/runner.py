@@ -97,8 +97,8 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     view, connect = _reachable_viewers(view, connect, viewer_required)
     from .io.checkpoint import Checkpointer, checkpoint_interval
     from .io.progress import Progress
-    from .io.summary import schedule_table, summary_table
-    from .io.results import ResultsWriter
+    from .io.summary import falloff_values, schedule_table, summary_table
+    from .io.results import ResultsWriter, open_results
 
     state = kept = None
     if resume:
@@ -141,11 +141,13 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     writer.close("complete", summary)
     closure = _write_closure(writer, scene) if scene.closure is not None else {}
     summary.update(closure)
-    summary.update(_write_falloff(writer, scene))
+    balance = open_results(writer.path).fracture_balance if scene.has("fracture") else None
+    falloff = _write_falloff(writer, scene, balance)
+    summary.update(falloff_values(falloff) if falloff is not None else {})
     if progress:  # in the output units; the file keeps SI
         if scene.injection is not None:
             print(schedule_table(scene, scene.output.units), flush=True)
-        print(summary_table(summary, scene.output.units, scene), flush=True)
+        print(summary_table(summary, scene.output.units, scene, balance, falloff), flush=True)
     return summary
 
 
@@ -161,20 +163,17 @@ def _checked(bar: Any, stop: Any) -> Callable[[float], None]:
     return progress
 
 
-def _write_falloff(writer: Any, scene: Scene) -> dict[str, Any]:
-    """Read the fall-off of a complete run with a shut-in (hfgpu.io.summary.falloff_of) and add its
-    ``falloff_*`` values to ``/summary``; return those (none without a shut-in)."""
-    from .io.results import open_results
+def _write_falloff(writer: Any, scene: Scene, balance: dict[str, Any] | None) -> Any:
+    """Read the fall-off of a complete run with a shut-in from its ``/fracture/balance`` (hfgpu.io.summary.falloff_of),
+    add its ``falloff_*`` values to ``/summary`` and return the analysis (None without a shut-in)."""
     from .io.summary import falloff_of, falloff_values, pump_end
 
-    if not scene.has("fracture") or scene.injection is None:
-        return {}
-    analysis = falloff_of(open_results(writer.path).fracture_balance, pump_end(scene), scene.rock.plane_strain_modulus)
-    if analysis is None:
-        return {}
-    values = falloff_values(analysis)
-    writer.add_summary(values)
-    return values
+    if not balance or scene.injection is None:
+        return None
+    analysis = falloff_of(balance, pump_end(scene), scene.rock.plane_strain_modulus)
+    if analysis is not None:
+        writer.add_summary(falloff_values(analysis))
+    return analysis
 
 
 def _write_closure(writer: Any, scene: Scene) -> dict[str, Any]:

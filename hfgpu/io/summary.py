@@ -331,9 +331,10 @@ def shared_density(scene: Any) -> float | None:
 
 
 def summary_table(summary: dict[str, Any], system: str = "SI", scene: Any = None,
-                  balance: dict[str, np.ndarray] | None = None) -> str:
+                  balance: dict[str, np.ndarray] | None = None, falloff: Any = None) -> str:
     """The run's summary as a grouped text table (:data:`GROUPS`) in ``system``'s units; ``balance`` is the run's
-    ``/fracture/balance`` (default: read from the summary's results file ``out`` when there is one)."""
+    ``/fracture/balance`` (default: read from the summary's results file ``out`` when there is one), ``falloff``
+    its :func:`falloff_of` analysis (default: computed from ``balance``)."""
     if balance is None and "out" in summary:
         from ..errors import HfgpuError
         from .results import open_results
@@ -345,7 +346,8 @@ def summary_table(summary: dict[str, Any], system: str = "SI", scene: Any = None
     stp = surface_history(balance, scene)
     pressures = treatment_pressures(balance, pump_end(scene), stp) if balance and scene is not None else None
     stp_end = float(stp[-1]) if stp is not None and stp.size else None
-    falloff = falloff_of(balance, pump_end(scene), _e_prime(scene)) if balance and scene is not None else None
+    if falloff is None and balance and scene is not None:
+        falloff = falloff_of(balance, pump_end(scene), _e_prime(scene))
     return _table(summary_rows(summary, system, shared_density(scene), pressures, stp_end, falloff))
 
 
