@@ -29,9 +29,9 @@ varies from run to run); the engine keeps the parcels sorted by cell, so runs ar
 from hfgpu.kernels.closures import bed, drag, particle_stress
 from hfgpu.kernels.closures.walls import blocked
 from hfgpu.kernels.layout import (
-    PARAM_COUNT,
+    PARAM_COUNT, BED_STRENGTH,
     M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME, MOMENT_COUNT,
-    BED_STRENGTH, BRIDGED, CELL, DAMPING, DENSITY, DRAG, F_DP, F_DTAU, F_MASK, F_VELOCITY, GONE, LAG_X, LAG_Z, MEAN_U,
+    BRIDGED, CELL, DAMPING, DENSITY, DRAG, F_DP, F_DTAU, F_MASK, F_VELOCITY, GONE, LAG_X, LAG_Z, MEAN_U,
     F_WIDTH, MEAN_V, OUTLET, P_BED_FRICTION, P_BRIDGING, P_DAMPING_THRESHOLD, P_DRAG_ITERATIONS, P_DRAG_LAW, P_DX, P_DZ,
     P_EPSILON, P_FRICTION_FRACTION, P_GRAVITY, P_MU, P_PACKING_RESTITUTION, P_RE_COEFFICIENT, P_RHO_F, P_SHIELDS,
     P_THETA_CP, P_WALL_LAW, P_X0, P_Z0, PARTICLES, RADIUS, S_DAMPING, S_DPDX, S_DPDZ, S_DTDX, S_DTDZ, S_MEAN_U,
