@@ -8,7 +8,8 @@ Measured (NumPy backend, seed 0; by owning row k, the bed rows k = 4 (top) .. 7)
 - sub-critical, at 1 s, along the bed (x): "overburden" holds the bed below its top cell at <= 6.6e-7 m/s
   (mean 2e-9), "grain" lets it creep at up to 5.1e-5 m/s (mean 7.8e-7); at 2 s both are at rest there. The
   top cell, whose grains have the own-weight friction under either closure, creeps at up to 1.9e-3 m/s at 1 s
-  and 4e-4 m/s at 2 s (a grain is held where mu_b g' exceeds the drag D u_f of the fluid in the bed, D ~ 6e3 1/s: u_f < 0.6 mm/s).
+  and 4e-4 m/s at 2 s (a grain is held where mu_b g' exceeds the drag D u_f of the fluid in the bed, D ~ 6e3
+  1/s: u_f < 0.6 mm/s).
 - supercritical, at 0.5 s, mean |u|: the surface layer (k = 3, grains on the bed) 5e-2 m/s, then 3.5e-3,
   6.8e-4, 4.4e-5 and 0 down the bed with "overburden" (3.1e-3, 6.6e-4, 4.8e-5, 6.6e-6 with "grain"): the
   surface moves as bed load, the interior does not follow.
