@@ -5,12 +5,13 @@ hfgpu.proppant.interpolation (active_nodes, face_widths) and hfgpu.proppant.simu
 Layout: hfgpu.kernels.layout.
 """
 
-from hfgpu.kernels.closures import damping, particle_stress
+from hfgpu.kernels.closures import bed, damping, particle_stress
 from hfgpu.kernels.layout import (
-    CELL, DAMPING, DEPOSIT_BETA, DEPOSIT_FORCE, F_BETA, F_DP, F_DTAU, F_FORCE, F_MASK, F_VELOCITY, F_WIDTH,
-    M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME, MEAN_U, MEAN_V, MOMENT_COUNT, OUTLET,
-    P_DAMPING, P_DAMPING_THRESHOLD, P_DX, P_DZ, P_EPSILON, P_FRICTION_FRACTION, P_RESTITUTION, P_STRESS_BETA,
-    P_STRESS_P, P_THETA_CP, PRESSURE, SAUTER, TAU, THETA, VARIANCE, WIDTH)
+    BED_STRENGTH, CELL, DAMPING, DEPOSIT_BETA, DEPOSIT_FORCE, F_BETA, F_DP, F_DTAU, F_FORCE, F_MASK, F_VELOCITY,
+    F_WIDTH, M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME, MEAN_U, MEAN_V, MOMENT_COUNT,
+    OUTLET, P_BED_FRICTION, P_BED_STRESS, P_DAMPING, P_DAMPING_THRESHOLD, P_DX, P_DZ, P_EPSILON,
+    P_FRICTION_FRACTION, P_GRAVITY, P_RESTITUTION, P_RHO_F, P_STRESS_BETA, P_STRESS_P, P_THETA_CP, PRESSURE,
+    SAUTER, TAU, THETA, VARIANCE, WIDTH)
 from hfgpu.kernels.runtime import ti
 from hfgpu.kernels.stencil import cell_flags, free_grains
 
@@ -131,6 +132,19 @@ def finish_cells(C: ti.template(), CD: ti.template(), copies: ti.i32, PR: ti.tem
 
 
 @ti.func
+def bed_strength_pass(C: ti.template(), PR: ti.template()):
+    """The overburden's bed friction per unit mass a_f of every cell into C[BED_STRENGTH], one thread per column
+    scanning down (closures.bed.column_strength; particle_ops_numpy.bed_strength); 0 with bed_stress "grain"."""
+    for i in range(C.shape[2]):
+        if PR[P_BED_STRESS] > 0.0:
+            bed.column_strength(C, i, PR[P_FRICTION_FRACTION], PR[P_DX], PR[P_RHO_F], PR[P_GRAVITY],
+                                PR[P_BED_FRICTION])
+        else:
+            for k in range(C.shape[1]):
+                C[BED_STRENGTH, k, i] = 0.0
+
+
+@ti.func
 def stress_gradient(C: ti.template(), F: ti.template(), spacing: ti.f64, axis: ti.template()):
     """d tau / dx (or dz) at the active faces of one face set, 0 elsewhere (particle_ops_numpy.grid_fields)."""
     for k, i in ti.ndrange((0, F.shape[1]), (0, F.shape[2])):
@@ -174,4 +188,4 @@ def finish_faces(C: ti.template(), F: ti.template(), D: ti.template(), copies: t
 
 
 __all__ = ["set_faces", "set_cells", "flags_pass", "load_faces", "load_pressure", "zero_copies", "finish_cells",
-           "stress_gradient", "finish_faces"]
+           "bed_strength_pass", "stress_gradient", "finish_faces"]

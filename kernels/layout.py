@@ -15,7 +15,7 @@ Parcels (capacity ``cap``; the first ``n`` columns are in use):
 Grid (nz, nx cells):
     C (CELL_CHANNELS, nz, nx): width, open-cell mask, dynamic pressure, the scattered moments and the fields the
         parcels read (theta_p, mean velocity, velocity variance, Sauter radius, particle stress, damping rate),
-        outlet mask
+        outlet mask, the bed friction per unit mass of the overburden (hfgpu.kernels.closures.bed)
     XF (FACE_CHANNELS, nz, nx+1) and ZF (FACE_CHANNELS, nz+1, nx): active-face mask, face width, fluid velocity,
         pressure and stress gradients, the sub-loop's mean interphase force F and implicit drag beta (Eq. 39)
     FLAGS (nz, nx) int32: stencil_flags
@@ -70,9 +70,9 @@ M_MASS_SPEED2 = MOMENT_FIELDS.index("mass_speed2")
 M_NR3 = MOMENT_FIELDS.index("n_r3")
 M_NR2 = MOMENT_FIELDS.index("n_r2")
 MOMENT_COUNT = len(MOMENT_FIELDS)
-WIDTH, CELL, PRESSURE, THETA, MEAN_U, MEAN_V, VARIANCE, SAUTER, TAU, DAMPING, OUTLET = range(MOMENT_COUNT,
-                                                                                            MOMENT_COUNT + 11)
-CELL_CHANNELS = OUTLET + 1
+(WIDTH, CELL, PRESSURE, THETA, MEAN_U, MEAN_V, VARIANCE, SAUTER, TAU, DAMPING, OUTLET,
+ BED_STRENGTH) = range(MOMENT_COUNT, MOMENT_COUNT + 12)
+CELL_CHANNELS = BED_STRENGTH + 1
 # face channels (XF, ZF): the same for both face sets
 F_MASK, F_WIDTH, F_VELOCITY, F_DP, F_DTAU, F_FORCE, F_BETA = range(7)
 FACE_CHANNELS = 7
@@ -82,7 +82,8 @@ DEPOSIT_FORCE, DEPOSIT_BETA = range(2)
 # hfgpu.proppant.params.MppicParams takes that attribute's value; the others are the run's: the grid frame's x0,
 # z0, dx, dz, the fluid's density rho_f [kg/m^3] and viscosity mu_f [Pa s], gravity [m/s^2]
 PARAMS = ("x0", "z0", "dx", "dz", "theta_cp", "epsilon", "packing_restitution", "drag_law_code",
-          "drag_re_coefficient", "bridging_factor", "drag_iterations", "bed_friction", "friction_volume_fraction",
+          "drag_re_coefficient", "bridging_factor", "drag_iterations", "bed_friction", "bed_stress_code",
+          "friction_volume_fraction",
           "shields_deposition", "wall_friction_code", "rho_f", "mu_f", "gravity", "P_s", "beta", "restitution",
           "damping", "damping_threshold")
 P_X0 = PARAMS.index("x0")
@@ -97,6 +98,7 @@ P_RE_COEFFICIENT = PARAMS.index("drag_re_coefficient")
 P_BRIDGING = PARAMS.index("bridging_factor")
 P_DRAG_ITERATIONS = PARAMS.index("drag_iterations")
 P_BED_FRICTION = PARAMS.index("bed_friction")
+P_BED_STRESS = PARAMS.index("bed_stress_code")
 P_FRICTION_FRACTION = PARAMS.index("friction_volume_fraction")
 P_SHIELDS = PARAMS.index("shields_deposition")
 P_WALL_LAW = PARAMS.index("wall_friction_code")

@@ -29,7 +29,7 @@ varies from run to run); the engine keeps the parcels sorted by cell, so runs ar
 from hfgpu.kernels.closures import bed, drag, particle_stress
 from hfgpu.kernels.closures.walls import blocked
 from hfgpu.kernels.layout import (
-    PARAM_COUNT,
+    PARAM_COUNT, BED_STRENGTH,
     M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME, MOMENT_COUNT,
     BRIDGED, CELL, DAMPING, DENSITY, DRAG, F_DP, F_DTAU, F_MASK, F_VELOCITY, GONE, LAG_X, LAG_Z, MEAN_U,
     F_WIDTH, MEAN_V, OUTLET, P_BED_FRICTION, P_BRIDGING, P_DAMPING_THRESHOLD, P_DRAG_ITERATIONS, P_DRAG_LAW, P_DX, P_DZ,
@@ -320,7 +320,8 @@ def move(p: ti.i32, sx: ti.f64, sz: ti.f64, flag: ti.i32, P: ti.template(), dt: 
 @ti.func
 def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(), C: ti.template(),
                 FLAGS: ti.template(), dt: ti.f64, PR: ti.template()):
-    """After the drag solve of parcel p: bed friction (on_bed), the threshold of motion on a bed surface
+    """After the drag solve of parcel p: bed friction (on_bed; a_f the larger of the own weight's and the own
+    cell's BED_STRENGTH, particle_ops_numpy.bed_friction), the threshold of motion on a bed surface
     (deposited, with shields_deposition), bridging, the move, and the lags 1 - r of the implicit drag
     (simulator.parcel_response)."""
     sx, sz = cell_coordinates(P, p, PR)
@@ -331,8 +332,10 @@ def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(),
     if not flag & LOOSE:
         if on_bed(sx, sz, P[RADIUS, p], PR[P_DZ], C, dense) > 0.0:
             den = 1.0 + dt * (W[DRAG, p] + 0.5 * W[S_DAMPING, p])
-            P[U, p] = bed.bed_friction(P[U, p], (1.0 - rho_f / P[DENSITY, p]) * gravity, dt, den,
-                                       PR[P_BED_FRICTION])
+            k, i = owner(sx, sz)
+            friction = ti.max(PR[P_BED_FRICTION] * ti.abs((1.0 - rho_f / P[DENSITY, p]) * gravity),
+                              C[BED_STRENGTH, k, i])
+            P[U, p] = bed.bed_friction(P[U, p], friction, dt, den)
             if PR[P_SHIELDS] > 0.0:
                 if deposited(sx, sz, W[S_UF, p], W[S_WIDTH, p], P[RADIUS, p], P[DENSITY, p], C, dense, rho_f,
                              PR[P_MU], gravity, ti.cast(PR[P_WALL_LAW], ti.i32)):

@@ -111,7 +111,7 @@ class NumpyEngine:
         outflow = 0.0
         for s in range(count):
             moments = ref.finish_moments(ref.moment_sums(parcels, frame, width), frame, width)
-            fields = ref.grid_fields(frame, width, u, v, p, moments, params)
+            fields = ref.grid_fields(frame, width, u, v, p, moments, params, self.rho_f, self.gravity)
             seen = ref.gather(parcels, frame, fields)
             drag = ref.push(parcels, seen, frame, fields, h, params, self.rho_f, self.mu_f, self.gravity)
             force = ref.exchange(parcels, seen, drag, frame, width)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import SceneError
+from ..kernels.closures.bed import BED_STRESSES
 from ..kernels.closures.drag import DRAG_LAWS
 from ..kernels.closures.slurry_viscosity import VISCOSITY_LAWS
 from ..kernels.closures.wall_friction import WALL_FRICTION_LAWS, wall_friction_code
@@ -45,6 +46,11 @@ class MppicParams:
     stays put until the tangential drag exceeds mu_b x its submerged weight (static friction), and a sliding
     one is slowed. Default tan(28.5 deg) = 0.543, the angle of internal friction of Johnson & Jackson (1987,
     J. Fluid Mech. 176) used for sand-like beds in MFIX; 0 turns it off.
+    bed_stress: the normal stress bed friction acts on (hfgpu.kernels.closures.bed): "grain" = the grain's own
+    submerged weight (above); "overburden" = in a dense cell, the submerged weight of the contact network
+    above down to the cell's base, sigma_v, whose shear strength mu_b sigma_v the cell's grains share (at
+    least their own weight's): a bed n cells deep holds n times the drag at its base that its surface cell
+    holds. Default "overburden" (measurements in docs/proppant-closures.md, "Bed friction").
     friction_volume_fraction: a parcel feels bed friction where theta_p of its own cell or of the cell below it
     (+z) is >= this (a contact network), and also where it lies on a floor (within one diameter of a closed
     cell or the grid edge below it); default 0.5, the onset of frictional stress of Johnson & Jackson (1987)
@@ -80,6 +86,7 @@ class MppicParams:
     damping: bool = True
     damping_threshold: float = 0.5
     bed_friction: float = 0.543
+    bed_stress: str = "overburden"
     friction_volume_fraction: float = 0.5
     wall_friction: str = "laminar"
     shields_deposition: bool = True
@@ -103,6 +110,8 @@ class MppicParams:
             raise bad("drag_law", f"allowed: one of {list(DRAG_LAWS)}")
         if self.viscosity_law not in VISCOSITY_LAWS:
             raise bad("viscosity_law", f"allowed: one of {list(VISCOSITY_LAWS)}")
+        if self.bed_stress not in BED_STRESSES:
+            raise bad("bed_stress", f"allowed: one of {list(BED_STRESSES)}")
         if self.wall_friction not in WALL_FRICTION_LAWS:
             raise bad("wall_friction", f"allowed: one of {list(WALL_FRICTION_LAWS)}")
         if not self.viscosity_exponent < 0.0:
@@ -124,6 +133,11 @@ class MppicParams:
     def drag_law_code(self) -> int:
         """Integer code of the drag law for kernels: 0 wen-yu (Eq. 14), 1 snider."""
         return DRAG_LAWS.index(self.drag_law)
+
+    @property
+    def bed_stress_code(self) -> int:
+        """Integer code of the bed stress for kernels: 0 grain, 1 overburden (closures.bed.BED_STRESSES)."""
+        return BED_STRESSES.index(self.bed_stress)
 
     @property
     def wall_friction_code(self) -> int:

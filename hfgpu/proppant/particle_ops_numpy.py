@@ -47,7 +47,8 @@ class CellMoments:
 class GridFields:
     """Node fields the gather and push read: activity masks, fluid velocities and gradients at faces, the cell
     fields theta_p, mean parcel velocity, damping rate and width (the push reads theta_p and width for its
-    walls and packing cap). Built once per particle step by ``grid_fields``."""
+    walls and packing cap) and bed_strength, the bed friction per unit mass of the overburden a_f [m/s^2]
+    (hfgpu.kernels.closures.bed). Built once per particle step by ``grid_fields``."""
 
     cell_mask: np.ndarray
     xface_mask: np.ndarray
@@ -64,6 +65,7 @@ class GridFields:
     damping_rate: np.ndarray
     width: np.ndarray
     free_grains: np.ndarray
+    bed_strength: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -132,9 +134,10 @@ def finish_moments(sums: np.ndarray, frame: GridFrame, width: np.ndarray) -> Cel
 
 
 def grid_fields(frame: GridFrame, width: np.ndarray, u: np.ndarray, v: np.ndarray, pressure: np.ndarray,
-                moments: CellMoments, params: MppicParams) -> GridFields:
+                moments: CellMoments, params: MppicParams, fluid_density: float, gravity: float) -> GridFields:
     """Node fields for the gather: pressure and stress (Eq. 16) gradients differenced to active faces
-    (0 elsewhere), the damping rate 1/tau_D per cell (O'Rourke & Snider 2010 eq. 48) and ``free_grains``."""
+    (0 elsewhere), the damping rate 1/tau_D per cell (O'Rourke & Snider 2010 eq. 48), ``free_grains`` and the
+    overburden's bed friction per unit mass (closures.bed.bed_strength_numpy; 0 with bed_stress "grain")."""
     check_fluid(width, u, v, pressure)
     cell, xmask, zmask = active_nodes(width)
     tau = closures.particle_stress(moments.volume_fraction, params)
@@ -157,7 +160,18 @@ def grid_fields(frame: GridFrame, width: np.ndarray, u: np.ndarray, v: np.ndarra
                       dpdx=grad_x(pressure), dpdz=grad_z(pressure), dtaudx=grad_x(tau), dtaudz=grad_z(tau),
                       volume_fraction=moments.volume_fraction, mean_u=moments.mean_u, mean_v=moments.mean_v,
                       damping_rate=damping * cell, width=np.ascontiguousarray(width, dtype=np.float64),
-                      free_grains=free_grains(moments.volume_fraction, params))
+                      free_grains=free_grains(moments.volume_fraction, params),
+                      bed_strength=bed_strength(frame, width, moments, params, fluid_density, gravity))
+
+
+def bed_strength(frame: GridFrame, width: np.ndarray, moments: CellMoments, params: MppicParams,
+                 fluid_density: float, gravity: float) -> np.ndarray:
+    """a_f per cell with bed_stress "overburden" (closures.bed.bed_strength_numpy), zeros with "grain"."""
+    if params.bed_stress == "grain":
+        return np.zeros_like(moments.mass)
+    return bed.bed_strength_numpy(moments.mass, moments.solid_volume, width, moments.volume_fraction,
+                                  params.friction_volume_fraction, frame.dx, fluid_density, gravity,
+                                  params.bed_friction)
 
 
 def free_grains(volume_fraction: np.ndarray, params: MppicParams) -> np.ndarray:
@@ -222,6 +236,15 @@ def _deposited(x, z, on_bed, seen: ParcelFluid, radius, rho_p, frame: GridFrame,
                                     gravity, params.wall_friction_code)
 
 
+def bed_friction(parcels: Parcels, frame: GridFrame, fields: GridFields, buoyant_g: np.ndarray,
+                 params: MppicParams) -> np.ndarray:
+    """Bed friction per unit mass a_f of each parcel (closures.bed): mu_b |g'| of its own submerged weight, or
+    the larger of that and its own cell's ``bed_strength`` (0 outside a contact network and with "grain")."""
+    own = params.bed_friction * np.abs(buoyant_g)
+    k, i, inside = owning_cell(parcels.x, parcels.z, frame, fields.width.shape)
+    return np.maximum(own, np.where(inside, fields.bed_strength[k, i], 0.0))
+
+
 def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFields, dt: float,
          params: MppicParams, fluid_density: float, fluid_viscosity: float, gravity: float) -> np.ndarray:
     """Advance parcel velocities (Eq. 43) and positions (Eq. 44) in place; returns D_p per parcel [1/s].
@@ -240,7 +263,8 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     that arrives together against a wall; the cap bounds every cell's theta_p by theta_cp plus one step's
     inflow, whatever the parcels' velocities.
     Bed friction: where the parcel rests in or on a dense bed or on the floor (on_bed) its x velocity is
-    reduced by Coulomb friction (hfgpu.kernels.closures.bed, mu_b = bed_friction) before the walls; with
+    reduced by Coulomb friction (hfgpu.kernels.closures.bed, mu_b = bed_friction, on the normal stress
+    bed_stress names: ``bed_friction``) before the walls; with
     shields_deposition, one on a bed surface below the threshold of motion (_deposited) stops along x.
     Bridging: where the width of the parcel's cell is below bridging_factor x 2 r the parcel is set to state 1
     with zero velocity and does not move; others get state 0. Gravity [m/s^2] acts along +z (depth).
@@ -263,7 +287,7 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     v_new = v_new + packing_limiter_numpy(scale * seen.dtaudz, seen.mean_v - v_new, seen.dtaudz,
                                           params.packing_restitution)
     resting = on_bed(parcels.x, parcels.z, parcels.radius, frame, fields.width, fields.volume_fraction, params)
-    u_new = bed.bed_friction_numpy(u_new, resting, buoyant_g, dt, den, params.bed_friction)
+    u_new = bed.bed_friction_numpy(u_new, resting, bed_friction(parcels, frame, fields, buoyant_g, params), dt, den)
     u_new = np.where(_deposited(parcels.x, parcels.z, resting, seen, parcels.radius, rho_p, frame, fields, params,
                                 fluid_density, fluid_viscosity, gravity), 0.0, u_new)
     bridged = seen.width < params.bridging_factor * 2.0 * parcels.radius

@@ -1,12 +1,40 @@
-"""The bed: Coulomb friction of grains resting in or on a dense bed, and the threshold of motion of grains on
-a bed surface; NumPy references and Taichi twins. Where a grain rests (on a dense cell, on the floor) is the
-push's business (particle_ops_numpy.on_bed, kernels.particles.on_bed); this family says what the bed does.
+"""The bed: Coulomb friction of grains resting in or on a dense bed, the overburden stress that friction acts on,
+and the threshold of motion of grains on a bed surface; NumPy references and Taichi twins. Where a grain rests
+(on a dense cell, on the floor) is the push's business (particle_ops_numpy.on_bed, kernels.particles.on_bed);
+this family says what the bed does.
 
-Bed friction, in the implicit velocity update of Eq. 43: the friction force per unit mass mu_b |g'| (g' =
-(1 - rho_f / rho_p) g, the submerged weight) opposes the motion along the bed (x, normal to gravity) and, being
-static friction, at most cancels it:
+Bed friction, in the implicit velocity update of Eq. 43: a friction force per unit mass a_f opposes the motion
+along the bed (x, normal to gravity) and, being static friction, at most cancels it:
 
-    u <- sign(u) max(|u| - dt mu_b |g'| / den, 0),    den = 1 + dt (D_p + 1 / (2 tau_D)) (Eq. 43's).
+    u <- sign(u) max(|u| - dt a_f / den, 0),    den = 1 + dt (D_p + 1 / (2 tau_D)) (Eq. 43's).
+
+What presses the grain onto the bed (``bed_stress``, BED_STRESSES):
+
+- "grain": its own submerged weight, a_f = mu_b |g'|, g' = (1 - rho_f / rho_p) g.
+- "overburden": Coulomb friction on the vertical normal stress of the grains above, as the frictional stress
+  of dense granular flow is (Johnson & Jackson 1987, J. Fluid Mech. 176, 67: tau = p_f sin phi, p_f the
+  frictional normal stress; Schaeffer 1987, J. Differ. Equations 66, 19), with the normal stress taken as the
+  submerged weight of the contact network above (a Janssen column without wall friction). The stress at the
+  base of cell k of a column is the submerged weight per unit area of the run of dense cells (theta_p >=
+  friction_volume_fraction) that ends at k, counted from the top of that run (a loose or closed cell carries
+  no contact network and starts the run again):
+
+      sigma_v(k) = sum_{j = top of the run .. k} theta_p,j (rho_p,j - rho_f) g dz
+                 = sum_j (m_j - rho_f V_j) g / (dx w_j)      (m_j, V_j: solid mass and volume of cell j),
+
+  and the base's shear strength mu_b sigma_v(k) is shared by the grains of cell k, per unit mass
+
+      a_f(k) = mu_b sigma_v(k) dx w_k / m_k,
+
+  so a grain of the top cell of a run has the own-weight friction (a_f = mu_b g' at one density) and one n
+  equal cells deep n times it. A parcel on a bed whose own cell is dense takes max(mu_b |g'|, a_f(k)); one
+  on a loose cell (a surface grain, a grain on the floor) its own weight's. What it leaves out: the load that
+  the cells above pass down through a cell's top (each cell mobilises the whole strength of its base for its
+  own grains): right where the drag of a flow over the bed acts on its top cell, an overestimate under a load
+  through the whole depth (seepage), whose Coulomb criterion does not grow with depth; and Janssen's
+  saturation (1895, Z. Ver. Dtsch. Ing. 39, 1045): the fracture faces carry part of the weight, sigma_v ->
+  gamma' w / (2 mu_w K) over a depth w / (2 mu_w K) (~2.5 w at mu_w = 0.5, K = 0.4), but the same face
+  friction resists sliding along x, which is not counted either (docs/proppant-closures.md).
 
 Threshold of motion: a grain of diameter d on a bed surface is held where the Shields number (Shields 1936)
 of the bed shear stress is below the critical one of Soulsby & Whitehouse (1997, Proc. Pacific Coasts and
@@ -26,23 +54,61 @@ f_t the fluid's wall-friction factor (closures.wall_friction: the same ratio of 
 on the fracture faces). A neutrally buoyant grain (rho_p = rho_f) has no threshold and is never held.
 """
 
+from __future__ import annotations
+
 import numpy as np
 
 from hfgpu.kernels.closures.twin import ti
 from hfgpu.kernels.closures.wall_friction import wall_friction_factor, wall_friction_factor_numpy
+from hfgpu.kernels.layout import BED_STRENGTH, M_MASS, M_VOLUME, THETA, WIDTH
+
+#: what presses a resting grain onto the bed (module docstring); the kernels' code is the index
+BED_STRESSES = ("grain", "overburden")
 
 
-def bed_friction_numpy(u, resting, buoyant_g, dt, den, mu_b):
-    """u after bed friction (module docstring) where ``resting``, unchanged elsewhere; buoyant_g = g' [m/s^2]."""
-    slide = np.maximum(np.abs(u) - dt * mu_b * np.abs(buoyant_g) / den, 0.0)
+def bed_friction_numpy(u, resting, friction, dt, den):
+    """u after bed friction (module docstring) where ``resting``, unchanged elsewhere; friction = a_f [m/s^2]."""
+    slide = np.maximum(np.abs(u) - dt * friction / den, 0.0)
     return np.where(resting, np.copysign(slide, u), u)
 
 
 @ti.func
-def bed_friction(u, buoyant_g, dt, den, mu_b):
-    """u of a resting grain after bed friction (module docstring), scalar."""
-    slide = ti.max(ti.abs(u) - dt * mu_b * ti.abs(buoyant_g) / den, 0.0)
+def bed_friction(u, friction, dt, den):
+    """u of a resting grain after bed friction a_f (module docstring), scalar."""
+    slide = ti.max(ti.abs(u) - dt * friction / den, 0.0)
     return -slide if u < 0.0 else slide
+
+
+def bed_strength_numpy(mass, volume, width, volume_fraction, dense, dx, fluid_density, gravity, mu_b):
+    """a_f(k) = mu_b sigma_v(k) dx w_k / m_k [m/s^2] per cell (nz, nx) of the "overburden" stress (module
+    docstring), 0 outside the contact network (theta_p < ``dense``); the columns scanned down (+z)."""
+    strength = np.zeros_like(mass)
+    above = np.zeros(mass.shape[1])
+    for k in range(mass.shape[0]):
+        network = (volume_fraction[k] >= dense) & (width[k] > 0.0) & (mass[k] > 0.0)
+        span = np.where(network, dx * width[k], 1.0)
+        above = np.where(network, above + (mass[k] - fluid_density * volume[k]) * gravity / span, 0.0)
+        strength[k] = np.where(network, mu_b * above * span / np.where(network, mass[k], 1.0), 0.0)
+    return strength
+
+
+@ti.func
+def column_strength(cells: ti.template(), i: ti.i32, dense: ti.f64, dx: ti.f64, fluid_density: ti.f64,
+                    gravity: ti.f64, mu_b: ti.f64):
+    """a_f of every cell of column i into cells[BED_STRENGTH] (bed_strength_numpy), scanning down; the moment
+    channels M_MASS, M_VOLUME, THETA and WIDTH of ``cells`` (hfgpu.kernels.layout) are read."""
+    above = 0.0
+    for k in range(cells.shape[1]):
+        mass = cells[M_MASS, k, i]
+        width = cells[WIDTH, k, i]
+        strength = 0.0
+        if cells[THETA, k, i] >= dense and width > 0.0 and mass > 0.0:
+            span = dx * width
+            above = above + (mass - fluid_density * cells[M_VOLUME, k, i]) * gravity / span
+            strength = mu_b * above * span / mass
+        else:
+            above = 0.0
+        cells[BED_STRENGTH, k, i] = strength
 
 
 def bed_shear_stress_numpy(speed, width, fluid_density, viscosity, code: int):

@@ -27,7 +27,8 @@ PARAM_SLOTS = {"P_X0": "x0", "P_Z0": "z0", "P_DX": "dx", "P_DZ": "dz", "P_THETA_
                "P_EPSILON": "epsilon", "P_PACKING_RESTITUTION": "packing_restitution",
                "P_DRAG_LAW": "drag_law_code", "P_RE_COEFFICIENT": "drag_re_coefficient",
                "P_BRIDGING": "bridging_factor", "P_DRAG_ITERATIONS": "drag_iterations",
-               "P_BED_FRICTION": "bed_friction", "P_FRICTION_FRACTION": "friction_volume_fraction",
+               "P_BED_FRICTION": "bed_friction", "P_BED_STRESS": "bed_stress_code",
+               "P_FRICTION_FRACTION": "friction_volume_fraction",
                "P_SHIELDS": "shields_deposition", "P_WALL_LAW": "wall_friction_code", "P_RHO_F": "rho_f",
                "P_MU": "mu_f", "P_GRAVITY": "gravity", "P_STRESS_P": "P_s", "P_STRESS_BETA": "beta",
                "P_RESTITUTION": "restitution", "P_DAMPING": "damping", "P_DAMPING_THRESHOLD": "damping_threshold"}
@@ -81,9 +82,9 @@ def test_moment_channels_index_the_sums_by_name():
 
 
 def test_cell_channels_follow_the_moments():
-    """The cell channels WIDTH ... OUTLET come after the MOMENT_COUNT moment sums, each once."""
+    """The cell channels WIDTH ... BED_STRENGTH come after the MOMENT_COUNT moment sums, each once."""
     names = ("WIDTH", "CELL", "PRESSURE", "THETA", "MEAN_U", "MEAN_V", "VARIANCE", "SAUTER", "TAU", "DAMPING",
-             "OUTLET")
+             "OUTLET", "BED_STRENGTH")
     assert [getattr(L, n) for n in names] == list(range(L.MOMENT_COUNT, L.CELL_CHANNELS))
 
 
@@ -92,8 +93,8 @@ def distinctive_params() -> MppicParams:
     return dataclasses.replace(
         MppicParams(), theta_cp=0.61, P_s=4.5, beta=2.5, epsilon=3e-7, restitution=0.85, drag_law="snider",
         drag_re_coefficient=0.17, bridging_factor=2.3, drag_iterations=5, packing_restitution=0.1, damping=False,
-        damping_threshold=0.45, bed_friction=0.6, friction_volume_fraction=0.52, wall_friction="dean",
-        shields_deposition=False)
+        damping_threshold=0.45, bed_friction=0.6, bed_stress="grain", friction_volume_fraction=0.52,
+        wall_friction="dean", shields_deposition=False)
 
 
 def test_param_vector_fills_each_slot_by_name():
@@ -113,7 +114,7 @@ def test_param_vector_fills_each_slot_by_name():
         assert out[slot] == value, constant
     assert out[L.P_DRAG_LAW] == 1.0 and out[L.P_WALL_LAW] == 1.0 and out[L.P_DRAG_ITERATIONS] == 5.0
     assert out[L.P_STRESS_P] == 4.5 and out[L.P_STRESS_BETA] == 2.5 and out[L.P_THETA_CP] == 0.61
-    assert out[L.P_DAMPING] == 0.0 and out[L.P_SHIELDS] == 0.0
+    assert out[L.P_DAMPING] == 0.0 and out[L.P_SHIELDS] == 0.0 and out[L.P_BED_STRESS] == 0.0
     on = param_vector(dataclasses.replace(params, damping=True, shields_deposition=True), grid, rho_f, mu_f,
                       gravity)
     assert on[L.P_DAMPING] == 1.0 and on[L.P_SHIELDS] == 1.0

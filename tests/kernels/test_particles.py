@@ -175,7 +175,7 @@ def test_exchange_is_equal_and_opposite():
     frame, width, parcels, fluid = random_case(seed=2)
     params = MppicParams()
     moments = ref.finish_moments(ref.moment_sums(parcels, frame, width), frame, width)
-    fields = ref.grid_fields(frame, width, fluid["u"], fluid["v"], fluid["pressure"], moments, params)
+    fields = ref.grid_fields(frame, width, fluid["u"], fluid["v"], fluid["pressure"], moments, params, RHO_F, G)
     seen = ref.gather(parcels, frame, fields)
     drag = ref.push(parcels, seen, frame, fields, 2e-3, params, RHO_F, MU, G)
     fx, fz = ref.exchange(parcels, seen, drag, frame, width)
@@ -200,7 +200,7 @@ def test_grains_in_a_contact_network_leave_the_pressure_gradient_to_the_skeleton
     moments = ref.finish_moments(ref.moment_sums(parcels, frame, width), frame, width)
     fraction = float(np.median(moments.volume_fraction[moments.volume_fraction > 0]))
     params = MppicParams(friction_volume_fraction=fraction)
-    fields = ref.grid_fields(frame, width, fluid["u"], fluid["v"], fluid["pressure"], moments, params)
+    fields = ref.grid_fields(frame, width, fluid["u"], fluid["v"], fluid["pressure"], moments, params, RHO_F, G)
     seen = ref.gather(parcels, frame, fields)
     k, i, _ = ref.owning_cell(parcels.x, parcels.z, frame, width.shape)
     network = moments.volume_fraction[k, i] >= fraction
