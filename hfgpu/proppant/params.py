@@ -50,7 +50,8 @@ class MppicParams:
     submerged weight (above); "overburden" = in a dense cell, the submerged weight of the contact network
     above down to the cell's base, sigma_v, whose shear strength mu_b sigma_v the cell's grains share (at
     least their own weight's): a bed n cells deep holds n times the drag at its base that its surface cell
-    holds. Default "overburden" (measurements in docs/proppant-closures.md, "Bed friction").
+    holds. Default "grain": the field-case and five-layer figures of the docs are measured with it ("overburden":
+    docs/proppant-closures.md, "Bed friction").
     friction_volume_fraction: a parcel feels bed friction where theta_p of its own cell or of the cell below it
     (+z) is >= this (a contact network), and also where it lies on a floor (within one diameter of a closed
     cell or the grid edge below it); default 0.5, the onset of frictional stress of Johnson & Jackson (1987)
@@ -86,7 +87,7 @@ class MppicParams:
     damping: bool = True
     damping_threshold: float = 0.5
     bed_friction: float = 0.543
-    bed_stress: str = "overburden"
+    bed_stress: str = "grain"
     friction_volume_fraction: float = 0.5
     wall_friction: str = "laminar"
     shields_deposition: bool = True

@@ -140,13 +140,13 @@ def test_bed_surface_moves_above_the_critical_shields_stress():
 
 
 def test_bed_stress_key():
-    """[mppic] bed_stress: default "overburden"; "grain" accepted; another value refused in one line naming the
+    """[mppic] bed_stress: default "grain"; "overburden" accepted; another value refused in one line naming the
     key, the value and the allowed ones."""
     from hfgpu.errors import SceneError
 
-    assert load_scene(scene(0.1, "grain", 1.0)).proppant.params.bed_stress == "grain"
+    assert load_scene(scene(0.1, "overburden", 1.0)).proppant.params.bed_stress == "overburden"
     assert load_scene(scene(0.1, "overburden", 1.0).replace('bed_stress = "overburden"', "")) \
-        .proppant.params.bed_stress == "overburden"
+        .proppant.params.bed_stress == "grain"
     with pytest.raises(SceneError) as err:
         load_scene(scene(0.1, "janssen", 1.0))
     assert str(err.value) == "scene key 'mppic.bed_stress': got 'janssen'; allowed: one of ['grain', 'overburden']"
