@@ -1,7 +1,7 @@
 """The MP-PIC particle engine: time per fluid step against the time its kernels take, and parcel-updates/s.
 
     python bench/bench_kernels.py [--sizes 1e4 1e5 1e6] [--arch cpu] [--threads 2] [--substeps 4]
-                                  [--steps 5] [--numpy-up-to 1e5]
+                                  [--steps 5] [--numpy-up-to 1e5] [--averaging dual moment]
 
 Grid 200 x 100 cells (nx x nz), a random open/closed width field, random parcels in open cells, random fluid.
 A fluid step is what the run loop does with the engine: begin_step (sort by cell, compaction, fluid in),
@@ -10,7 +10,8 @@ one warm-up step; the machine may be shared): wall ms per fluid step, the kernel
 kernel profiler: device time without Python, launch and argument overhead), their ratio (the overhead
 target: <= 2 at 1e4-1e5 parcels), the launches per fluid step, the whole sub-step in M parcel-updates/s from
 its kernel time and from wall time, and the NumPy engine's wall ms per fluid step (the oracle) up to
-``--numpy-up-to`` parcels. Asserts nothing. bench/bench_gpu.py runs the same on CUDA.
+``--numpy-up-to`` parcels; one table per ``--averaging`` name (hfgpu.kernels.closures.averaging). Asserts
+nothing. bench/bench_gpu.py runs the same on CUDA.
 """
 
 from __future__ import annotations
@@ -76,11 +77,12 @@ class Profiler:
         return total
 
 
-def measure(name: str, n: int, substeps: int, steps: int, profile: bool) -> dict[str, float]:
+def measure(name: str, n: int, substeps: int, steps: int, profile: bool, averaging: str = "dual") -> dict[str, float]:
     """Wall and kernel seconds per fluid step, launches per fluid step and the sub-steps' kernel seconds of
-    engine ``name`` at ``n`` parcels (the fluid step of least wall time)."""
+    engine ``name`` at ``n`` parcels with ``averaging`` (the fluid step of least wall time)."""
     grid, parcels, fluid = make_case(n)
-    engine = make_engine(name, grid, MppicParams(), RHO_F, MU, G, np.zeros(grid.shape, dtype=bool))
+    engine = make_engine(name, grid, MppicParams(averaging=averaging), RHO_F, MU, G,
+                         np.zeros(grid.shape, dtype=bool))
     engine.set_parcels(parcels)
     fluid_step(engine, fluid, substeps)
     rows = []
@@ -101,23 +103,25 @@ def main() -> None:
     ap.add_argument("--substeps", type=int, default=4)
     ap.add_argument("--steps", type=int, default=5)
     ap.add_argument("--numpy-up-to", type=float, default=1e5)
+    ap.add_argument("--averaging", nargs="+", default=["dual"], help="averaging names, one table each")
     args = ap.parse_args()
     arch = init(args.arch, kernel_profiler=True, cpu_threads=args.threads)
     threads = ti.lang.impl.current_cfg().cpu_max_num_threads if arch == "cpu" else "-"
-    print(f"grid {NX} x {NZ}, {args.substeps} sub-steps per fluid step, Taichi on {arch} ({threads} threads); "
-          f"best of {args.steps} fluid steps")
-    head = (f"{'parcels':>9} | {'wall ms':>9} | {'kernel ms':>9} | {'wall/kernel':>11} | {'launches':>8} | "
-            f"{'sub-step M/s (kernel)':>21} | {'(wall)':>7} | {'numpy ms':>9}")
-    print(head)
-    print("-" * len(head))
-    for size in args.sizes:
-        n = int(size)
-        t = measure("taichi", n, args.substeps, args.steps, profile=True)
-        numpy_ms = (f"{1e3 * measure('numpy', n, args.substeps, 2, profile=False)['wall']:9.1f}"
-                    if n <= args.numpy_up_to else f"{'-':>9}")
-        print(f"{n:>9} | {1e3 * t['wall']:9.2f} | {1e3 * t['kernels']:9.2f} | {t['wall'] / t['kernels']:11.2f} | "
-              f"{t['launches']:8.0f} | {n / t['substep'] / 1e6:21.1f} | "
-              f"{n * args.substeps / t['wall'] / 1e6:7.1f} | {numpy_ms}")
+    for averaging in args.averaging:
+        print(f"grid {NX} x {NZ}, {args.substeps} sub-steps per fluid step, Taichi on {arch} ({threads} threads); "
+              f"best of {args.steps} fluid steps; averaging {averaging!r}")
+        head = (f"{'parcels':>9} | {'wall ms':>9} | {'kernel ms':>9} | {'wall/kernel':>11} | {'launches':>8} | "
+                f"{'sub-step M/s (kernel)':>21} | {'(wall)':>7} | {'numpy ms':>9}")
+        print(head)
+        print("-" * len(head))
+        for size in args.sizes:
+            n = int(size)
+            t = measure("taichi", n, args.substeps, args.steps, profile=True, averaging=averaging)
+            numpy_ms = (f"{1e3 * measure('numpy', n, args.substeps, 2, False, averaging)['wall']:9.1f}"
+                        if n <= args.numpy_up_to else f"{'-':>9}")
+            print(f"{n:>9} | {1e3 * t['wall']:9.2f} | {1e3 * t['kernels']:9.2f} | {t['wall'] / t['kernels']:11.2f} | "
+                  f"{t['launches']:8.0f} | {n / t['substep'] / 1e6:21.1f} | "
+                  f"{n * args.substeps / t['wall'] / 1e6:7.1f} | {numpy_ms}")
 
 
 if __name__ == "__main__":

@@ -9,7 +9,8 @@ the arguments typed NUMPY cross between host and device; everything else stays w
 """
 
 from hfgpu.kernels import grid, particles, store
-from hfgpu.kernels.layout import (F_BETA, F_FORCE, M_MASS, M_VOLUME, MEAN_U, MEAN_V, MOMENT_COUNT, NO_BAD, SAUTER,
+from hfgpu.kernels.layout import (F_BETA, F_FORCE, M_MASS, M_OWN, M_OWN_X, M_OWN_Z, M_VOLUME, MEAN_U, MEAN_V,
+                                  MOMENT_COUNT, NO_BAD, SAUTER,
                                   THETA, VARIANCE, P_DX, P_DZ, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW,
                                   ST_SPEED, ST_VOLUME)
 from hfgpu.kernels.runtime import ti
@@ -19,7 +20,8 @@ from hfgpu.kernels.runtime import ti
 #: (the fields of hfgpu.proppant.particle_ops_numpy.CellMoments)
 FACE_OUT = dict(force=F_FORCE, beta=F_BETA)
 CELL_OUT = dict(volume_fraction=THETA, solid_volume=M_VOLUME, mass=M_MASS, mean_u=MEAN_U, mean_v=MEAN_V,
-                velocity_variance=VARIANCE, sauter_radius=SAUTER)
+                velocity_variance=VARIANCE, sauter_radius=SAUTER, own_volume=M_OWN, own_volume_x=M_OWN_X,
+                own_volume_z=M_OWN_Z)
 _FACE_CHANNELS, _CELL_CHANNELS = tuple(FACE_OUT.values()), tuple(CELL_OUT.values())  # read_channels' static tuples
 
 F1 = ti.types.ndarray(dtype=ti.f64, ndim=1)

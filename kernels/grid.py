@@ -8,7 +8,7 @@ Layout: hfgpu.kernels.layout.
 from hfgpu.kernels.closures import bed, damping, particle_stress
 from hfgpu.kernels.layout import (
     BED_STRENGTH, CELL, DAMPING, DEPOSIT_BETA, DEPOSIT_FORCE, F_BETA, F_DP, F_DTAU, F_FORCE, F_MASK, F_VELOCITY,
-    F_WIDTH, M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME, MEAN_U, MEAN_V, MOMENT_COUNT,
+    F_WALLS, F_WIDTH, M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME, MEAN_U, MEAN_V, MOMENT_COUNT,
     OUTLET, P_BED_FRICTION, P_BED_STRESS, P_DAMPING, P_DAMPING_THRESHOLD, P_DX, P_DZ, P_EPSILON,
     P_FRICTION_FRACTION, P_GRAVITY, P_RESTITUTION, P_RHO_F, P_STRESS_BETA, P_STRESS_P, P_THETA_CP, PRESSURE,
     SAUTER, TAU, THETA, VARIANCE, WIDTH)
@@ -42,8 +42,9 @@ def face_sides(F: ti.template(), k: ti.i32, i: ti.i32, axis: ti.template()):
 
 @ti.func
 def set_faces(width: ti.template(), F: ti.template(), axis: ti.template()):
-    """Active-face mask (open cells on both sides, strictly inside the grid) and face width (the mean of the
-    two cells there, else 0) of one face set from the width field (interpolation.active_nodes, face_widths)."""
+    """Active-face mask (open cells on both sides, strictly inside the grid), face width (the mean of the two
+    cells there, else 0) and the mask of the fluid velocity's nodes (an open cell on at least one side) of one
+    face set from the width field (interpolation.active_nodes, face_widths, velocity_nodes)."""
     for k, i in ti.ndrange((0, F.shape[1]), (0, F.shape[2])):
         ka, ia, inside = face_sides(F, k, i, axis)
         mask = 0.0
@@ -52,8 +53,16 @@ def set_faces(width: ti.template(), F: ti.template(), axis: ti.template()):
             if width[ka, ia] > 0.0 and width[k, i] > 0.0:
                 mask = 1.0
                 w = 0.5 * (width[ka, ia] + width[k, i])
+        walls = 0.0
+        if ka >= 0 and ia >= 0:
+            if width[ka, ia] > 0.0:
+                walls = 1.0
+        if k < width.shape[0] and i < width.shape[1]:
+            if width[k, i] > 0.0:
+                walls = 1.0
         F[F_MASK, k, i] = mask
         F[F_WIDTH, k, i] = w
+        F[F_WALLS, k, i] = walls
 
 
 @ti.func

@@ -60,8 +60,12 @@ LAG_Z = WORK_FIELDS.index("lag_z")
 WORK_ROWS = len(WORK_FIELDS)
 
 # cell channels (C); the moment sums of the scatter come first: sums over parcels of solid volume n V_p, mass,
-# mass u, mass v, mass |u|^2, n r^3, n r^2 (hfgpu.proppant.particle_ops_numpy.moment_sums names its sums by these)
-MOMENT_FIELDS = ("volume", "mass", "mass_u", "mass_v", "mass_speed2", "n_r3", "n_r2")
+# mass u, mass v, mass |u|^2, n r^3, n r^2 with the bilinear weights, then over the parcels a cell holds (nearest
+# grid point) of n V_p and n V_p times the offset from the cell centre in cells along x and z (the averaging
+# family's S, S_x, S_z, hfgpu.kernels.closures.averaging; hfgpu.proppant.particle_ops_numpy.moment_sums names its
+# sums by these)
+MOMENT_FIELDS = ("volume", "mass", "mass_u", "mass_v", "mass_speed2", "n_r3", "n_r2", "own_volume", "own_volume_x",
+                 "own_volume_z")
 M_VOLUME = MOMENT_FIELDS.index("volume")
 M_MASS = MOMENT_FIELDS.index("mass")
 M_MASS_U = MOMENT_FIELDS.index("mass_u")
@@ -69,13 +73,17 @@ M_MASS_V = MOMENT_FIELDS.index("mass_v")
 M_MASS_SPEED2 = MOMENT_FIELDS.index("mass_speed2")
 M_NR3 = MOMENT_FIELDS.index("n_r3")
 M_NR2 = MOMENT_FIELDS.index("n_r2")
+M_OWN = MOMENT_FIELDS.index("own_volume")
+M_OWN_X = MOMENT_FIELDS.index("own_volume_x")
+M_OWN_Z = MOMENT_FIELDS.index("own_volume_z")
 MOMENT_COUNT = len(MOMENT_FIELDS)
 (WIDTH, CELL, PRESSURE, THETA, MEAN_U, MEAN_V, VARIANCE, SAUTER, TAU, DAMPING, OUTLET,
  BED_STRENGTH) = range(MOMENT_COUNT, MOMENT_COUNT + 12)
 CELL_CHANNELS = BED_STRENGTH + 1
-# face channels (XF, ZF): the same for both face sets
-F_MASK, F_WIDTH, F_VELOCITY, F_DP, F_DTAU, F_FORCE, F_BETA = range(7)
-FACE_CHANNELS = 7
+# face channels (XF, ZF): the same for both face sets; F_WALLS masks the nodes the fluid velocity is read on (the
+# active faces and the walls, hfgpu.proppant.interpolation.velocity_nodes)
+F_MASK, F_WIDTH, F_VELOCITY, F_DP, F_DTAU, F_FORCE, F_BETA, F_WALLS = range(8)
+FACE_CHANNELS = 8
 DEPOSIT_FORCE, DEPOSIT_BETA = range(2)
 
 # run constants (PR), filled by name (hfgpu.proppant.engine_taichi.param_vector): a name that is an attribute of
@@ -85,7 +93,7 @@ PARAMS = ("x0", "z0", "dx", "dz", "theta_cp", "epsilon", "packing_restitution", 
           "drag_re_coefficient", "bridging_factor", "drag_iterations", "bed_friction", "bed_stress_code",
           "friction_volume_fraction",
           "shields_deposition", "wall_friction_code", "rho_f", "mu_f", "gravity", "P_s", "beta", "restitution",
-          "damping", "damping_threshold")
+          "damping", "damping_threshold", "averaging_code")
 P_X0 = PARAMS.index("x0")
 P_Z0 = PARAMS.index("z0")
 P_DX = PARAMS.index("dx")
@@ -110,6 +118,7 @@ P_STRESS_BETA = PARAMS.index("beta")
 P_RESTITUTION = PARAMS.index("restitution")
 P_DAMPING = PARAMS.index("damping")
 P_DAMPING_THRESHOLD = PARAMS.index("damping_threshold")
+P_AVERAGING = PARAMS.index("averaging_code")
 PARAM_COUNT = len(PARAMS)
 # sub-loop reports (ST)
 ST_OUTFLOW, ST_SPEED, ST_BAD_STEP, ST_BAD_PARCEL, ST_GONE, ST_LIVE, ST_VOLUME, ST_LEFT = range(8)

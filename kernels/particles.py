@@ -26,14 +26,15 @@ results are deterministic, and random parcel order costs little more than sorted
 varies from run to run); the engine keeps the parcels sorted by cell, so runs are long and atomics few.
 """
 
-from hfgpu.kernels.closures import bed, drag, particle_stress
+from hfgpu.kernels.closures import averaging, bed, drag, particle_stress
 from hfgpu.kernels.closures.walls import blocked
 from hfgpu.kernels.layout import (
     PARAM_COUNT, BED_STRENGTH,
-    M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME, MOMENT_COUNT,
-    BRIDGED, CELL, DAMPING, DENSITY, DRAG, F_DP, F_DTAU, F_MASK, F_VELOCITY, GONE, LAG_X, LAG_Z, MEAN_U,
+    M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_OWN, M_OWN_X, M_OWN_Z, M_VOLUME, MOMENT_COUNT,
+    BRIDGED, CELL, DAMPING, DENSITY, DRAG, F_DP, F_DTAU, F_MASK, F_VELOCITY, F_WALLS, GONE, LAG_X, LAG_Z, MEAN_U,
     F_WIDTH, MEAN_V, OUTLET, P_BED_FRICTION, P_BRIDGING, P_DAMPING_THRESHOLD, P_DRAG_ITERATIONS, P_DRAG_LAW, P_DX, P_DZ,
-    P_EPSILON, P_FRICTION_FRACTION, P_GRAVITY, P_MU, P_PACKING_RESTITUTION, P_RE_COEFFICIENT, P_RHO_F, P_SHIELDS,
+    P_AVERAGING, P_EPSILON, P_FRICTION_FRACTION, P_GRAVITY, P_MU, P_PACKING_RESTITUTION, P_RE_COEFFICIENT, P_RHO_F,
+    P_SHIELDS,
     P_THETA_CP, P_WALL_LAW, P_X0, P_Z0, PARTICLES, RADIUS, S_DAMPING, S_DPDX, S_DPDZ, S_DTDX, S_DTDZ, S_MEAN_U,
     S_MEAN_V, S_THETA, S_UF, S_VF, S_WIDTH, SEEN, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW, ST_SPEED,
     ST_VOLUME, STATE, SUSPENDED, THETA, U, V, WIDTH, X, Z)
@@ -129,8 +130,17 @@ def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template()
                     total += vol
                     fastest = ti.max(fastest, ti.abs(u) + ti.abs(v))
                     for j in ti.static(range(4)):
-                        for c in ti.static(range(MOMENT_COUNT)):
+                        for c in ti.static(range(M_OWN)):
                             acc[j, c] += vals[c] * w[j]
+                    ko, io = owner(sx, sz)   # the averaging's sums over the parcels a cell holds
+                    if ko >= 0 and ko < C.shape[1]:
+                        if io >= 0 and io < C.shape[2]:
+                            own = 2 * (ko - k0) + (io - i0)
+                            for j in ti.static(range(4)):
+                                if j == own:
+                                    acc[j, M_OWN] += vol
+                                    acc[j, M_OWN_X] += vol * (sx - io)
+                                    acc[j, M_OWN_Z] += vol * (sz - ko)
             flush(CD, copy, kb, ib, acc, MOMENT_COUNT, private)
             report_block(BS, ST, block, 0, ST_VOLUME, total, fastest, private)
 
@@ -138,11 +148,17 @@ def scatter_pass(P: ti.template(), S: ti.template(), n: ti.i32, C: ti.template()
 @ti.func
 def seen_at(sx: ti.f64, sz: ti.f64, interior: ti.template(), C: ti.template(), XF: ti.template(),
             ZF: ti.template(), PR: ti.template()):
-    """The SEEN grid values at cell coordinates (sx, sz) (Eq. 40-41 with x-/z-face weights; cell fields with
-    cell weights; the width of the own cell); ``interior``: the own cell is INTERIOR (bilinear). The pressure
-    gradient is 0 where the own cell is in a contact network (particle_ops_numpy.gather)."""
+    """The SEEN grid values at cell coordinates (sx, sz) (Eq. 40-41 with x-/z-face weights, the fluid velocity's
+    over the active faces and the walls, F_WALLS; cell fields with cell weights; the width of the own cell);
+    ``interior``: the own cell is INTERIOR (bilinear: no wall in reach, both face weights the same). The
+    pressure gradient is 0 where the own cell is in a contact network (particle_ops_numpy.gather)."""
     kx, ix, wx = bilinear(sx + 0.5, sz, XF, F_MASK, interior)
     kz, iz, wz = bilinear(sx, sz + 0.5, ZF, F_MASK, interior)
+    kxu, ixu, wxu = kx, ix, wx
+    kzv, izv, wzv = kz, iz, wz
+    if ti.static(not interior):
+        kxu, ixu, wxu = bilinear(sx + 0.5, sz, XF, F_WALLS, False)
+        kzv, izv, wzv = bilinear(sx, sz + 0.5, ZF, F_WALLS, False)
     kc, ic, wc = bilinear(sx, sz, C, CELL, interior)
     k, i = owner(sx, sz)
     own = 0.0
@@ -151,18 +167,36 @@ def seen_at(sx: ti.f64, sz: ti.f64, interior: ti.template(), C: ti.template(), X
         own = C[WIDTH, k, i]
         free = free_grains(C[THETA, k, i], PR)
     s = ti.Vector.zero(ti.f64, SEEN)  # by row name (layout.SEEN_FIELDS)
-    s[S_UF] = sample(XF, F_VELOCITY, kx, ix, wx, interior)
-    s[S_VF] = sample(ZF, F_VELOCITY, kz, iz, wz, interior)
+    s[S_UF] = sample(XF, F_VELOCITY, kxu, ixu, wxu, interior)
+    s[S_VF] = sample(ZF, F_VELOCITY, kzv, izv, wzv, interior)
     s[S_DPDX] = free * sample(XF, F_DP, kx, ix, wx, interior)
     s[S_DPDZ] = free * sample(ZF, F_DP, kz, iz, wz, interior)
     s[S_DTDX] = sample(XF, F_DTAU, kx, ix, wx, interior)
     s[S_DTDZ] = sample(ZF, F_DTAU, kz, iz, wz, interior)
-    s[S_THETA] = sample(C, THETA, kc, ic, wc, interior)
+    s[S_THETA] = seen_fraction(sx, sz, sample(C, THETA, kc, ic, wc, interior), C, PR)
     s[S_MEAN_U] = sample(C, MEAN_U, kc, ic, wc, interior)
     s[S_MEAN_V] = sample(C, MEAN_V, kc, ic, wc, interior)
     s[S_DAMPING] = sample(C, DAMPING, kc, ic, wc, interior)
     s[S_WIDTH] = own
     return s
+
+
+@ti.func
+def seen_fraction(sx: ti.f64, sz: ti.f64, dual: ti.f64, C: ti.template(), PR: ti.template()) -> ti.f64:
+    """The volume fraction a parcel at cell coordinates (sx, sz) sees by the averaging PR[P_AVERAGING]
+    (closures.averaging): ``dual`` (the bilinear read of theta_p) for "dual", else from its own cell's S, S_x,
+    S_z (0 outside the grid; particle_ops_numpy.seen_fraction)."""
+    out = dual
+    code = ti.cast(PR[P_AVERAGING], ti.i32)
+    if code > 0:
+        out = 0.0
+        k, i = owner(sx, sz)
+        if k >= 0 and k < C.shape[1]:
+            if i >= 0 and i < C.shape[2]:
+                out = averaging.own_cell_fraction(C[M_OWN, k, i], C[M_OWN_X, k, i], C[M_OWN_Z, k, i], sx - i,
+                                                  sz - k, PR[P_DX] * PR[P_DZ] * ti.max(C[WIDTH, k, i], 0.0),
+                                                  code == 2)
+    return out
 
 
 @ti.func

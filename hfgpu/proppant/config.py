@@ -41,6 +41,8 @@ PORT_KINDS = ("point", "segment", "annulus")
 #: Directions an inlet's slurry may enter along as a jet (``jet``; "none": a source without momentum).
 JET_DIRECTIONS = ("none", "+x", "-x", "+z", "-z")
 BACKENDS = ("taichi", "numpy")
+#: Placements of the initial suspension's parcels in their cells (hfgpu.proppant.injection.initial_suspension).
+PLACEMENTS = ("lattice", "stratified")
 
 
 @dataclass(frozen=True)
@@ -112,6 +114,8 @@ class MppicNumerics:
     step whose Courant number came out above c_max before giving up.
     simple_tolerance / simple_max_iterations: Algorithm 1 stopping rule (relative |p'|).
     gravity [m/s^2] acts along +depth.
+    initial_placement: where the initial suspension's parcels sit in their cells, "lattice" (a quiet start:
+    theta_p starts without sampling noise) or "stratified" (random; hfgpu.proppant.injection.initial_suspension).
     slurry_viscosity: the fluid phase uses the slurry viscosity of Eq. 10 (MppicParams.viscosity_law); false
     uses the clean-fluid viscosity. Eq. 10 diverges at close packing; the momentum predictor takes the
     in-plane diffusion and wall friction implicitly and MppicParams.max_relative_viscosity caps mu_f / mu_0,
@@ -134,6 +138,7 @@ class MppicNumerics:
     simple_max_iterations: int = 50
     gravity: float = 9.81
     slurry_viscosity: bool = True
+    initial_placement: str = "lattice"
 
 
 @dataclass(frozen=True)
@@ -331,6 +336,7 @@ def _parse_mppic(t: Table, preset: Preset = BALANCED) -> tuple[MppicNumerics, An
         simple_max_iterations=t.integer("simple_max_iterations", d.simple_max_iterations, minimum=1),
         gravity=t.quantity("gravity", "acceleration", d.gravity, minimum=0.0),
         slurry_viscosity=t.boolean("slurry_viscosity", d.slurry_viscosity),
+        initial_placement=t.choice("initial_placement", PLACEMENTS, d.initial_placement),
     )
     params = _parse_params(t)
     t.finish()

@@ -11,6 +11,17 @@ faces of closed cells carry boundary conditions only: no fluid momentum is solve
 deposited there and no gradient is defined there). A parcel whose 4 nodes are all inactive gets all-zero
 weights (it deposits and reads nothing); a parcel in an open cell always has an active cell node (its own).
 
+The fluid velocity is read on more nodes (:func:`velocity_nodes`): the active faces and the walls, the faces
+with an open cell on one side only (domain edges, closed cells), where the normal velocity is the boundary
+condition 0. A parcel between the last active face and a wall so sees the normal velocity fall linearly to
+zero at the wall, as the fluid's own flux does. Read on the active faces only, it would see the last face's
+value up to the wall: the parcels near a wall would cross a face the fluid does not cross, and the volume
+fraction they deposit would change where the fluid's is held, at a rate theta_p u / dx. In a settling column
+with side walls that change drives a flow along the walls whose density difference drives it further; the
+measurement is in docs/proppant-closures.md ("Walls in the gather"). Along a wall (the tangential velocity)
+the stencil's nodes beyond the wall lie outside the grid and the renormalisation gives the free-slip value,
+as the fluid's viscous stress at walls is free-slip.
+
 The weights and the owning cell of a point are hfgpu.kernels.stencil_numpy's (weights, owning_cell); here are
 the node masks they take and the sums over them.
 """
@@ -29,6 +40,20 @@ def active_nodes(width: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     zface = np.zeros((nz + 1, nx), dtype=bool)
     zface[1:nz, :] = cell[:-1, :] & cell[1:, :]
     return cell.astype(np.float64), xface.astype(np.float64), zface.astype(np.float64)
+
+
+def velocity_nodes(width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(xface (nz, nx+1), zface (nz+1, nx)) masks, float64 1.0 / 0.0, of the nodes the fluid velocity is read
+    on: faces with an open cell on at least one side, the edges of the grid included (module docstring)."""
+    cell = width > 0.0
+    nz, nx = width.shape
+    xface = np.zeros((nz, nx + 1), dtype=bool)
+    xface[:, :-1] |= cell
+    xface[:, 1:] |= cell
+    zface = np.zeros((nz + 1, nx), dtype=bool)
+    zface[:-1, :] |= cell
+    zface[1:, :] |= cell
+    return xface.astype(np.float64), zface.astype(np.float64)
 
 
 def face_widths(width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

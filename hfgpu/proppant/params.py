@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import SceneError
+from ..kernels.closures.averaging import AVERAGINGS
 from ..kernels.closures.bed import BED_STRESSES
 from ..kernels.closures.drag import DRAG_LAWS
 from ..kernels.closures.slurry_viscosity import VISCOSITY_LAWS
@@ -52,6 +53,11 @@ class MppicParams:
     least their own weight's): a bed n cells deep holds n times the drag at its base that its surface cell
     holds. Default "grain": the field-case and five-layer figures of the docs are measured with it ("overburden":
     docs/proppant-closures.md, "Bed friction").
+    averaging: the volume fraction a parcel sees in its drag and packing limiter (hfgpu.kernels.closures.averaging,
+    OpenFOAM's AveragingMethods): "dual" = the bilinear deposit read back bilinearly; "basic" = its own cell's;
+    "moment" = the linear function over its own cell with the first moments of the cell's parcels. Default
+    "dual"; "moment" keeps the top interface of a settling suspension from piling parcels up but reads the
+    sampling noise of a random packing (docs/proppant-closures.md, "Averaging", measures both).
     friction_volume_fraction: a parcel feels bed friction where theta_p of its own cell or of the cell below it
     (+z) is >= this (a contact network), and also where it lies on a floor (within one diameter of a closed
     cell or the grid edge below it); default 0.5, the onset of frictional stress of Johnson & Jackson (1987)
@@ -88,6 +94,7 @@ class MppicParams:
     damping_threshold: float = 0.5
     bed_friction: float = 0.543
     bed_stress: str = "grain"
+    averaging: str = "dual"
     friction_volume_fraction: float = 0.5
     wall_friction: str = "laminar"
     shields_deposition: bool = True
@@ -113,6 +120,8 @@ class MppicParams:
             raise bad("viscosity_law", f"allowed: one of {list(VISCOSITY_LAWS)}")
         if self.bed_stress not in BED_STRESSES:
             raise bad("bed_stress", f"allowed: one of {list(BED_STRESSES)}")
+        if self.averaging not in AVERAGINGS:
+            raise bad("averaging", f"allowed: one of {list(AVERAGINGS)}")
         if self.wall_friction not in WALL_FRICTION_LAWS:
             raise bad("wall_friction", f"allowed: one of {list(WALL_FRICTION_LAWS)}")
         if not self.viscosity_exponent < 0.0:
@@ -139,6 +148,11 @@ class MppicParams:
     def bed_stress_code(self) -> int:
         """Integer code of the bed stress for kernels: 0 grain, 1 overburden (closures.bed.BED_STRESSES)."""
         return BED_STRESSES.index(self.bed_stress)
+
+    @property
+    def averaging_code(self) -> int:
+        """Integer code of the averaging for kernels: 0 dual, 1 basic, 2 moment (closures.averaging.AVERAGINGS)."""
+        return AVERAGINGS.index(self.averaging)
 
     @property
     def wall_friction_code(self) -> int:

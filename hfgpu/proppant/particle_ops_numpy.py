@@ -11,16 +11,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kernels.closures import bed
+from ..kernels.closures import averaging, bed
 from ..kernels.closures.particle_stress import packing_limiter_numpy
 from ..kernels.closures.walls import blocked_numpy
-from ..kernels.layout import (BRIDGED, M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME,
-                              MOMENT_COUNT, MOMENT_FIELDS, SEEN_FIELDS, SUSPENDED)
+from ..kernels.layout import (BRIDGED, M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_OWN, M_OWN_X,
+                              M_OWN_Z, M_VOLUME, MOMENT_COUNT, MOMENT_FIELDS, SEEN_FIELDS, SUSPENDED)
 from ..kernels.stencil_numpy import owning_cell, weights
 from ..records import GridFrame
 from . import closures
 from .grid import face_mean
-from .interpolation import active_nodes, deposit, deposit_masks, interpolate
+from .interpolation import active_nodes, deposit, deposit_masks, interpolate, velocity_nodes
 from .params import MppicParams
 from .parcels import Parcels
 
@@ -31,7 +31,8 @@ class CellMoments:
 
     volume_fraction theta_p = sum n V_p I / (dx dz w) (Eq. 38; 0 in closed cells); solid_volume = sum n V_p I
     [m^3]; mass [kg]; mean_u, mean_v: mass-averaged velocity; velocity_variance: mass-weighted mean of
-    |u - mean|^2 [m^2/s^2]; sauter_radius r32 = sum n r^3 / sum n r^2 [m] (0 where no parcel).
+    |u - mean|^2 [m^2/s^2]; sauter_radius r32 = sum n r^3 / sum n r^2 [m] (0 where no parcel); own_volume,
+    own_volume_x, own_volume_z: S, S_x, S_z of the parcels each cell holds (hfgpu.kernels.closures.averaging).
     """
 
     volume_fraction: np.ndarray
@@ -41,18 +42,26 @@ class CellMoments:
     mean_v: np.ndarray
     velocity_variance: np.ndarray
     sauter_radius: np.ndarray
+    own_volume: np.ndarray
+    own_volume_x: np.ndarray
+    own_volume_z: np.ndarray
 
 
 @dataclass(frozen=True)
 class GridFields:
-    """Node fields the gather and push read: activity masks, fluid velocities and gradients at faces, the cell
+    """Node fields the gather and push read: activity masks (and those of the fluid velocity, with the walls:
+    interpolation.velocity_nodes), fluid velocities and gradients at faces, the cell
     fields theta_p, mean parcel velocity, damping rate and width (the push reads theta_p and width for its
     walls and packing cap) and bed_strength, the bed friction per unit mass of the overburden a_f [m/s^2]
-    (hfgpu.kernels.closures.bed). Built once per particle step by ``grid_fields``."""
+    (hfgpu.kernels.closures.bed), and what the averaging (its name, ``averaging``) reads: the moments' S, S_x,
+    S_z and the cell volume dx dz w (hfgpu.kernels.closures.averaging). Built once per particle step by
+    ``grid_fields``."""
 
     cell_mask: np.ndarray
     xface_mask: np.ndarray
     zface_mask: np.ndarray
+    xface_velocity_mask: np.ndarray
+    zface_velocity_mask: np.ndarray
     fluid_u: np.ndarray
     fluid_v: np.ndarray
     dpdx: np.ndarray
@@ -66,6 +75,11 @@ class GridFields:
     width: np.ndarray
     free_grains: np.ndarray
     bed_strength: np.ndarray
+    own_volume: np.ndarray
+    own_volume_x: np.ndarray
+    own_volume_z: np.ndarray
+    cell_volume: np.ndarray
+    averaging: str
 
 
 @dataclass(frozen=True)
@@ -97,8 +111,10 @@ def check_fluid(width: np.ndarray, u: np.ndarray, v: np.ndarray, pressure: np.nd
 
 
 def moment_sums(parcels: Parcels, frame: GridFrame, width: np.ndarray) -> np.ndarray:
-    """Bilinear sums (MOMENT_COUNT, nz, nx) over parcels of the MOMENT_FIELDS (kernels/layout.py; numerators of
-    Eq. 38 and of the mass averages of O'Rourke & Snider 2010), each in its channel M_VOLUME, M_MASS, ... by name."""
+    """Sums (MOMENT_COUNT, nz, nx) over parcels of the MOMENT_FIELDS (kernels/layout.py), each in its channel
+    M_VOLUME, M_MASS, ... by name: with the bilinear weights the numerators of Eq. 38 and of the mass averages
+    of O'Rourke & Snider 2010; over the parcels each cell holds (nearest grid point) the averaging's S, S_x, S_z
+    (solid volume and solid volume times the offset from the cell centre in cells)."""
     shape = check_width(width)
     cell_weight, _, _ = deposit_masks(width)
     k, i, w = weights(parcels.x, parcels.z, frame, "cell", cell_weight)
@@ -107,11 +123,18 @@ def moment_sums(parcels: Parcels, frame: GridFrame, width: np.ndarray) -> np.nda
     values = {"volume": vol, "mass": mass, "mass_u": mass * parcels.u, "mass_v": mass * parcels.v,
               "mass_speed2": mass * (parcels.u ** 2 + parcels.v ** 2),
               "n_r3": parcels.particles * parcels.radius ** 3, "n_r2": parcels.particles * parcels.radius ** 2}
-    if set(values) != set(MOMENT_FIELDS):
-        raise RuntimeError(f"moment_sums: sums {sorted(values)} != MOMENT_FIELDS {sorted(MOMENT_FIELDS)}")
+    ko, io, inside = owning_cell(parcels.x, parcels.z, frame, shape)
+    own = np.where(inside, vol, 0.0)
+    owned = {"own_volume": own, "own_volume_x": own * ((parcels.x - frame.x0) / frame.dx - io),
+             "own_volume_z": own * ((parcels.z - frame.z0) / frame.dz - ko)}
+    if set(values) | set(owned) != set(MOMENT_FIELDS):
+        raise RuntimeError(f"moment_sums: sums {sorted(values) + sorted(owned)} != MOMENT_FIELDS "
+                           f"{sorted(MOMENT_FIELDS)}")
     sums = np.empty((MOMENT_COUNT, *shape))
     for name, val in values.items():
         sums[MOMENT_FIELDS.index(name)] = deposit(val, k, i, w, shape)
+    for name, val in owned.items():
+        sums[MOMENT_FIELDS.index(name)] = deposit(val, ko[:, None], io[:, None], np.ones((ko.size, 1)), shape)
     return sums
 
 
@@ -119,6 +142,7 @@ def finish_moments(sums: np.ndarray, frame: GridFrame, width: np.ndarray) -> Cel
     """CellMoments from the channel sums: theta_p by Eq. 38 (V = dx dz w), mass averages and Sauter radius."""
     vol, mass, mu, mv, ms2, nr3, nr2 = (sums[c] for c in (M_VOLUME, M_MASS, M_MASS_U, M_MASS_V, M_MASS_SPEED2,
                                                           M_NR3, M_NR2))
+    own, own_x, own_z = (np.ascontiguousarray(sums[c]) for c in (M_OWN, M_OWN_X, M_OWN_Z))
     cell_volume = frame.dx * frame.dz * width
 
     def ratio(a, b):
@@ -130,7 +154,7 @@ def finish_moments(sums: np.ndarray, frame: GridFrame, width: np.ndarray) -> Cel
                        mass=np.ascontiguousarray(mass),
                        mean_u=mean_u, mean_v=mean_v,
                        velocity_variance=np.maximum(ratio(ms2, mass) - mean_u ** 2 - mean_v ** 2, 0.0),
-                       sauter_radius=ratio(nr3, nr2))
+                       sauter_radius=ratio(nr3, nr2), own_volume=own, own_volume_x=own_x, own_volume_z=own_z)
 
 
 def grid_fields(frame: GridFrame, width: np.ndarray, u: np.ndarray, v: np.ndarray, pressure: np.ndarray,
@@ -154,14 +178,20 @@ def grid_fields(frame: GridFrame, width: np.ndarray, u: np.ndarray, v: np.ndarra
 
     damping = closures.damping_rate(moments.volume_fraction, moments.velocity_variance,
                                     moments.sauter_radius, params)
-    return GridFields(cell_mask=cell, xface_mask=xmask, zface_mask=zmask,
+    xvel, zvel = velocity_nodes(width)
+    return GridFields(cell_mask=cell, xface_mask=xmask, zface_mask=zmask, xface_velocity_mask=xvel,
+                      zface_velocity_mask=zvel,
                       fluid_u=np.ascontiguousarray(u, dtype=np.float64),
                       fluid_v=np.ascontiguousarray(v, dtype=np.float64),
                       dpdx=grad_x(pressure), dpdz=grad_z(pressure), dtaudx=grad_x(tau), dtaudz=grad_z(tau),
                       volume_fraction=moments.volume_fraction, mean_u=moments.mean_u, mean_v=moments.mean_v,
                       damping_rate=damping * cell, width=np.ascontiguousarray(width, dtype=np.float64),
                       free_grains=free_grains(moments.volume_fraction, params),
-                      bed_strength=bed_strength(frame, width, moments, params, fluid_density, gravity))
+                      bed_strength=bed_strength(frame, width, moments, params, fluid_density, gravity),
+                      own_volume=moments.own_volume, own_volume_x=moments.own_volume_x,
+                      own_volume_z=moments.own_volume_z,
+                      cell_volume=frame.dx * frame.dz * np.where(width > 0.0, width, 0.0),
+                      averaging=params.averaging)
 
 
 def bed_strength(frame: GridFrame, width: np.ndarray, moments: CellMoments, params: MppicParams,
@@ -185,22 +215,39 @@ def free_grains(volume_fraction: np.ndarray, params: MppicParams) -> np.ndarray:
 
 
 def gather(parcels: Parcels, frame: GridFrame, fields: GridFields) -> ParcelFluid:
-    """Grid fields at the parcels: face fields with x-/z-face weights (Eq. 40-41), cell fields with cell
-    weights, width of the own cell (0 outside the grid); the pressure gradient times the own cell's
-    ``free_grains`` (1 outside the grid)."""
+    """Grid fields at the parcels: face fields with x-/z-face weights (Eq. 40-41; the fluid velocity with the
+    walls' zero normal velocity among the nodes, interpolation.velocity_nodes), cell fields with cell weights,
+    width of the own cell (0 outside the grid); the pressure gradient times the own cell's ``free_grains`` (1
+    outside the grid)."""
     kc, ic, wc = weights(parcels.x, parcels.z, frame, "cell", fields.cell_mask)
     kx, ix, wx = weights(parcels.x, parcels.z, frame, "xface", fields.xface_mask)
     kz, iz, wz = weights(parcels.x, parcels.z, frame, "zface", fields.zface_mask)
+    kxu, ixu, wxu = weights(parcels.x, parcels.z, frame, "xface", fields.xface_velocity_mask)
+    kzv, izv, wzv = weights(parcels.x, parcels.z, frame, "zface", fields.zface_velocity_mask)
     ko, io, inside = owning_cell(parcels.x, parcels.z, frame, fields.width.shape)
     free = np.where(inside, fields.free_grains[ko, io], 1.0)
     return ParcelFluid(
-        fluid_u=interpolate(fields.fluid_u, kx, ix, wx), fluid_v=interpolate(fields.fluid_v, kz, iz, wz),
+        fluid_u=interpolate(fields.fluid_u, kxu, ixu, wxu), fluid_v=interpolate(fields.fluid_v, kzv, izv, wzv),
         dpdx=free * interpolate(fields.dpdx, kx, ix, wx), dpdz=free * interpolate(fields.dpdz, kz, iz, wz),
         dtaudx=interpolate(fields.dtaudx, kx, ix, wx), dtaudz=interpolate(fields.dtaudz, kz, iz, wz),
-        volume_fraction=interpolate(fields.volume_fraction, kc, ic, wc),
+        volume_fraction=seen_fraction(parcels, frame, fields, interpolate(fields.volume_fraction, kc, ic, wc)),
         mean_u=interpolate(fields.mean_u, kc, ic, wc), mean_v=interpolate(fields.mean_v, kc, ic, wc),
         damping_rate=interpolate(fields.damping_rate, kc, ic, wc),
         width=np.where(inside, fields.width[ko, io], 0.0))
+
+
+def seen_fraction(parcels: Parcels, frame: GridFrame, fields: GridFields, dual: np.ndarray) -> np.ndarray:
+    """The volume fraction the parcels see by ``fields.averaging`` (hfgpu.kernels.closures.averaging): ``dual``
+    (the bilinear read of the cells' theta_p) for "dual", else from the own cell's S, S_x, S_z (0 outside the
+    grid)."""
+    if fields.averaging == "dual":
+        return dual
+    ko, io, inside = owning_cell(parcels.x, parcels.z, frame, fields.width.shape)
+    value = averaging.own_cell_fraction_numpy(
+        fields.own_volume[ko, io], fields.own_volume_x[ko, io], fields.own_volume_z[ko, io],
+        (parcels.x - frame.x0) / frame.dx - io, (parcels.z - frame.z0) / frame.dz - ko,
+        fields.cell_volume[ko, io], fields.averaging == "moment")
+    return np.where(inside, value, 0.0)
 
 
 def on_bed(x, z, radius, frame: GridFrame, width: np.ndarray, volume_fraction: np.ndarray,

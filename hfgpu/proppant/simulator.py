@@ -177,7 +177,7 @@ class ProppantSimulation:
         self.outflow = 0.0
         self.screen_out_time = math.nan  # start of the first step whose inlets held proppant back
         self.add_parcels(initial_suspension(setup.classes, self.grid.frame, self.grid.width,
-                                            self.particles_per_parcel, self.rng))
+                                            self.particles_per_parcel, self.rng, self.numerics.initial_placement))
         self.injector = self._make_injector(schedule)
         self.moments = self.engine.moments()
         n = self.numerics

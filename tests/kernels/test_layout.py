@@ -21,7 +21,8 @@ SEEN_ROWS = {"S_UF": "fluid_u", "S_VF": "fluid_v", "S_DPDX": "dpdx", "S_DPDZ": "
              "S_DAMPING": "damping_rate", "S_WIDTH": "width"}
 #: each M_* channel and the moment it sums
 MOMENT_CHANNELS = {"M_VOLUME": "volume", "M_MASS": "mass", "M_MASS_U": "mass_u", "M_MASS_V": "mass_v",
-                   "M_MASS_SPEED2": "mass_speed2", "M_NR3": "n_r3", "M_NR2": "n_r2"}
+                   "M_MASS_SPEED2": "mass_speed2", "M_NR3": "n_r3", "M_NR2": "n_r2", "M_OWN": "own_volume",
+                   "M_OWN_X": "own_volume_x", "M_OWN_Z": "own_volume_z"}
 #: each P_* slot and the name of the constant it holds
 PARAM_SLOTS = {"P_X0": "x0", "P_Z0": "z0", "P_DX": "dx", "P_DZ": "dz", "P_THETA_CP": "theta_cp",
                "P_EPSILON": "epsilon", "P_PACKING_RESTITUTION": "packing_restitution",
@@ -31,7 +32,8 @@ PARAM_SLOTS = {"P_X0": "x0", "P_Z0": "z0", "P_DX": "dx", "P_DZ": "dz", "P_THETA_
                "P_FRICTION_FRACTION": "friction_volume_fraction",
                "P_SHIELDS": "shields_deposition", "P_WALL_LAW": "wall_friction_code", "P_RHO_F": "rho_f",
                "P_MU": "mu_f", "P_GRAVITY": "gravity", "P_STRESS_P": "P_s", "P_STRESS_BETA": "beta",
-               "P_RESTITUTION": "restitution", "P_DAMPING": "damping", "P_DAMPING_THRESHOLD": "damping_threshold"}
+               "P_RESTITUTION": "restitution", "P_DAMPING": "damping", "P_DAMPING_THRESHOLD": "damping_threshold",
+               "P_AVERAGING": "averaging_code"}
 
 
 def test_parcel_fluid_fields_are_the_seen_rows():
@@ -61,7 +63,8 @@ def test_moment_channels_index_the_sums_by_name():
     mass = vol * density
     expected = {"volume": vol, "mass": mass, "mass_u": mass * u, "mass_v": mass * v,
                 "mass_speed2": mass * (u ** 2 + v ** 2), "n_r3": particles * radius ** 3,
-                "n_r2": particles * radius ** 2}
+                "n_r2": particles * radius ** 2, "own_volume": vol, "own_volume_x": 0.0 * vol,
+                "own_volume_z": 0.0 * vol}   # at the cell centres: no offset
     assert set(expected) == set(L.MOMENT_FIELDS)
     sums = ref.moment_sums(parcels, frame, width)
     assert sums.shape == (L.MOMENT_COUNT, *width.shape) == (len(MOMENT_CHANNELS), *width.shape)
@@ -70,7 +73,7 @@ def test_moment_channels_index_the_sums_by_name():
         assert L.MOMENT_FIELDS[c] == name, constant
         for p, (k, i) in enumerate(cells):
             assert sums[c, k, i] == pytest.approx(expected[name][p], rel=1e-12), (constant, p)
-        assert np.count_nonzero(sums[c]) == 2, constant
+        assert np.count_nonzero(sums[c]) == (0 if name in ("own_volume_x", "own_volume_z") else 2), constant
     moments = ref.finish_moments(sums, frame, width)
     for p, (k, i) in enumerate(cells):
         assert moments.solid_volume[k, i] == sums[L.M_VOLUME, k, i]

@@ -151,11 +151,11 @@ def test_device_sort_is_the_stable_sort_by_cell_and_drops_what_left(private):
     assert engine.n == parcels.n - leaving.sum() == engine.parcels().n
 
 
-@pytest.mark.parametrize("private_bytes, blocks", [(64 * 2 ** 20, 15), (4 * 8 * 13 * 18 * 7, 4)])
+@pytest.mark.parametrize("private_bytes, blocks", [(64 * 2 ** 20, 15), (4 * 8 * 13 * 18 * L.MOMENT_COUNT, 4)])
 def test_deposits_in_many_private_copies_match_numpy(private_bytes, blocks):
     """The CPU deposits split the parcels into blocks, each summing into its own grid copy: 3000 parcels at
-    200 per copy give 15 copies (the most is 16); a budget of 4 copies of the 7-channel grid of 13 x 18 nodes
-    gives 4."""
+    200 per copy give 15 copies (the most is 16); a budget of 4 copies of the MOMENT_COUNT-channel grid of 13 x 18
+    nodes gives 4."""
     frame, width, parcels, fluid = random_case(seed=3)
     params = MppicParams()
     engine = engine_for("taichi", frame, width, params)
