@@ -1,0 +1,53 @@
+"""What the proppant tells the fracture in a two-way coupled run (hfgpu.coupled): ``Slurry`` fields on a grid.
+
+Three per-cell fields, held on the grid they come from (the proppant grid, ``frame``) and read by the fracture
+engine at its own cell centres (nearest cell; outside the frame the clean fluid's values, ``outside`` for the
+viscosity ratio):
+
+* ``ratio`` = mu_eff / mu >= 1, the slurry's effective viscosity over the carrier fluid's. The lubrication face
+  between cells P and E (Eq. 29) then conducts T_PE = (w_P + w_E)^3 / (8 mu' r_PE) (face length / centre
+  distance), r_PE = (r_P + r_E) / 2: the resistances of the two half cells in series (the pressure drop over
+  a half cell is proportional to its viscosity at equal flux and width);
+* ``blocked``: cells the front cannot advance into or through (bridged or packed slurry at the tip): a blocked
+  active cell opens no neighbour, a blocked inactive cell is not opened (front.cells_to_open's ``blocked``);
+* the tip asymptote (Eq. 33 with the M vertex, front.py) uses mu' times the mean ratio of the fracture's edge
+  cells (``tip_ratio``): one viscosity for the whole front (exact for a uniform slurry).
+
+A uniform slurry (the same ratio everywhere, ``outside`` included) is a fluid of viscosity r mu: the run then
+equals the clean-fluid run of that viscosity (tests/fracture/test_slurry.py checks it against the radial
+viscosity-vertex solution).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..records import GridFrame
+
+
+@dataclass(frozen=True, eq=False)
+class Slurry:
+    """The slurry's fields on the grid ``frame`` (each (nz, nx)); see the module docstring."""
+
+    frame: GridFrame
+    ratio: np.ndarray
+    blocked: np.ndarray
+    outside: float = 1.0
+
+    @classmethod
+    def uniform(cls, ratio: float) -> "Slurry":
+        """The same viscosity ratio everywhere, nothing blocked."""
+        return cls(GridFrame(1.0, 1.0, 0.0, 0.0), np.full((1, 1), float(ratio)), np.zeros((1, 1), bool),
+                   outside=float(ratio))
+
+    def at(self, x: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(ratio, blocked) at the points (x, z) (arrays of one shape): the nearest cell's, the clean fluid's
+        (``outside``, False) beyond the frame."""
+        nz, nx = self.ratio.shape
+        i = np.floor((np.asarray(x) - self.frame.x0) / self.frame.dx + 0.5).astype(int)
+        k = np.floor((np.asarray(z) - self.frame.z0) / self.frame.dz + 0.5).astype(int)
+        inside = (i >= 0) & (i < nx) & (k >= 0) & (k < nz)
+        i, k = np.clip(i, 0, nx - 1), np.clip(k, 0, nz - 1)
+        return np.where(inside, self.ratio[k, i], self.outside), inside & self.blocked[k, i]
