@@ -51,3 +51,15 @@ class Slurry:
         inside = (i >= 0) & (i < nx) & (k >= 0) & (k < nz)
         i, k = np.clip(i, 0, nx - 1), np.clip(k, 0, nz - 1)
         return np.where(inside, self.ratio[k, i], self.outside), inside & self.blocked[k, i]
+
+
+def held_tips(active: np.ndarray, blocked: np.ndarray | None) -> int:
+    """Blocked active cells whose neighbour along x (the fracture's length) is inactive: where a bridged or
+    packed slurry holds the front's lateral tip (a tip screen-out); 0 without blocked cells."""
+    if blocked is None:
+        return 0
+    tip = np.zeros_like(active)
+    tip[:, 1:] |= ~active[:, :-1]
+    tip[:, :-1] |= ~active[:, 1:]
+    tip[:, [0, -1]] = True
+    return int((active & blocked & tip).sum())
