@@ -1,4 +1,8 @@
-"""The integrated, one-way coupled run (the paper, section 4.3 and Fig. 4): fracture first, proppant on it.
+"""The integrated coupled run (the paper, section 4.3 and Fig. 4): one-way, fracture first and proppant on it
+(:func:`simulate`, below); two-way, the two interval by interval with the slurry acting on the fracture
+(``[coupling] mode = "two-way"``, :func:`simulate_two_way`, which reads like Fig. 4 top to bottom).
+
+One-way:
 
 A scene with ``physics = ["fracture", "proppant"]`` runs
 
@@ -33,7 +37,8 @@ line reports it above 5 % of the injected fluid.
 ``[coupling]`` keys (all optional): ``fracture_every`` (default end_time / 60), ``cell_size`` (one length or
 [dx, dz]; default the fracture cells), ``inlet_inner_radius`` (default 0), ``inlet_radius`` (outer radius of the
 annulus, default 1.5 x the larger proppant cell size: the injection cell and its eight neighbours),
-``proppant_start`` (see above), ``margin`` (cells around the largest footprint, default 1).
+``proppant_start`` (see above), ``margin`` (cells around the largest footprint, default 1), ``mode``
+("one-way", the default, or "two-way").
 """
 
 from __future__ import annotations
@@ -230,7 +235,8 @@ def warn_inconsistent_width(summary: dict) -> None:
 
 def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] | None = None,
              timings: Timings | None = None, checkpoint=None, resume: dict | None = None) -> dict:
-    """Run the coupled scene (module docstring): fracture, then proppant on the fracture history.
+    """Run the coupled scene (module docstring): fracture, then proppant on the fracture history (a two-way
+    scene goes to :func:`simulate_two_way`).
 
     ``sink`` gets the fracture and the proppant records (proppant times on the scene's clock); ``progress(t)``
     is called through both phases; ``timings`` (optional) collects wall time per phase. Returns a summary:

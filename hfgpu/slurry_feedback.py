@@ -5,12 +5,15 @@ Per cell of the proppant grid, of solid volume fraction theta_p and width w:
 
 * viscosity ratio r = mu(theta_p) / mu_o of ``[mppic] viscosity_law`` (Eq. 10, or Krieger & Dougherty; capped at
   ``max_relative_viscosity``: hfgpu.proppant.closures.slurry_viscosity);
-* a packed cell (theta_p >= PACKED_SHARE theta_cp, holding parcels) passes fluid as a porous medium, q = -(k w / mu) grad p
-  (Darcy) instead of q = -(w^3 / (12 mu)) grad p (Poiseuille): r = w^2 / (12 k) where that is larger, with k of
-  Kozeny-Carman on the cell's grains (hfgpu.closure.permeability.kozeny_carman: the Sauter diameter d_32 of the
-  cell's parcels, porosity 1 - theta_cp);
+* a packed cell (theta_p >= PACKED_SHARE theta_cp, holding parcels) passes fluid as a porous medium,
+  q = -(k w / mu) grad p (Darcy) instead of q = -(w^3 / (12 mu)) grad p (Poiseuille): r = w^2 / (12 k) where
+  that is larger, with k of Kozeny-Carman on the cell's grains (hfgpu.closure.permeability.kozeny_carman: the
+  Sauter diameter d_32 of the cell's parcels, porosity 1 - theta_cp);
 * blocked (the front cannot pass): packed cells, and bridged cells (:func:`hfgpu.coupling.screen_out_cells`:
-  width below ``bridging_factor`` x the largest grain in the cell).
+  width below ``bridging_factor`` x the largest grain in the cell);
+* floor: the width at which the cell's grains are at close packing, w_p = theta_p w / theta_cp: after shut-in the
+  walls close onto the proppant there and no further (the grains where they are, as ``[closure] settling =
+  "in_place"``).
 """
 
 from __future__ import annotations
@@ -58,4 +61,4 @@ def slurry_of(snap: ProppantSnapshot, params: MppicParams) -> Slurry:
         k = kozeny_carman(diameter[packed], 1.0 - params.theta_cp)
         ratio[packed] = np.maximum(ratio[packed], width[packed] ** 2 / (12.0 * k))
     blocked = packed | screen_out_cells(snap, params.bridging_factor)
-    return Slurry(snap.frame, ratio, blocked)
+    return Slurry(snap.frame, ratio, blocked, floor=theta * width / params.theta_cp)

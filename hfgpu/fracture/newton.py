@@ -102,6 +102,8 @@ class StepProblem:
     w_floor: float = 0.0      # the engine's closure width [m]: a face between two closed cells conducts as an
     #                           aperture of 2 w_floor (the walls in contact still pass pressure, so a closed
     #                           region's pressures stay determined); Newton's convergence test floors ||w|| there
+    w_contact: np.ndarray | None = None   # width at which the walls meet, per cell (a proppant pack's: slurry.py);
+    #                                       None: 0. The fluid below it does not leak (leak_fraction)
 
 
 @dataclass
@@ -124,6 +126,7 @@ class StepResult:
     work: NewtonWork          # the step's linear-algebra work (all contact passes)
     preconditioner: Any = None   # Newton-Krylov: the last preconditioner, for a next solve on the same cells
     demand: np.ndarray | None = None   # Carter's demand per cell over the step [m^3] (leaked: its ramped part)
+    contact: np.ndarray | None = None  # the step's w_contact (StepProblem)
 
 
 class Elasticity:
@@ -141,8 +144,11 @@ class Elasticity:
 
 
 def held_width(prob: StepProblem) -> np.ndarray | float:
-    """Width of a cell whose unknown is its pressure: the prescribed width of a pinned cell, 0 (contact)."""
-    return 0.0 if prob.pinned is None else np.nan_to_num(prob.pinned, nan=0.0)
+    """Width of a cell whose unknown is its pressure: the prescribed width of a pinned cell, the contact width
+    (0, or ``w_contact``)."""
+    if prob.pinned is not None:
+        return np.nan_to_num(prob.pinned, nan=0.0)
+    return 0.0 if prob.w_contact is None else prob.w_contact
 
 
 def _split(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray | None):
@@ -157,8 +163,9 @@ def _split(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nda
 
 def leak_fraction(prob: StepProblem, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The fraction of a cell's Carter demand it leaks and its derivative: the positivity ramp g(w)
-    (leakoff.available_fraction) times the cell's wetted fraction."""
-    g, dg = available_fraction(w, prob.w_eps)
+    (leakoff.available_fraction) times the cell's wetted fraction; with ``w_contact`` g(w - w_contact): the
+    fluid held in a proppant pack does not leak."""
+    g, dg = available_fraction(w if prob.w_contact is None else w - prob.w_contact, prob.w_eps)
     return (g, dg) if prob.wetted is None else (g * prob.wetted, dg * prob.wetted)
 
 
@@ -405,7 +412,8 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
         if not converged:
             break
         w, p = _split(prob, elastic, x, closed)
-        to_close = ~closed & (w < -CONTACT_TOLERANCE * float(np.abs(w).max()))
+        floor = 0.0 if prob.w_contact is None else prob.w_contact
+        to_close = ~closed & (w - floor < -CONTACT_TOLERANCE * float(np.abs(w).max()))
         to_open = closed & ~pinned & (prob.sigma + elastic.apply(w) < p)
         if not (to_close.any() or to_open.any()):
             break
@@ -415,4 +423,5 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
     r = residual(prob, elastic, x, closed)
     ok = converged and bool(np.all(np.isfinite(r.f)))
     return StepResult(w=r.w, p=r.p, leaked=prob.area * prob.demand * r.g, iterations=iterations, converged=ok,
-                      residual=r.f, work=work, preconditioner=preconditioner, demand=prob.area * prob.demand)
+                      residual=r.f, work=work, preconditioner=preconditioner, demand=prob.area * prob.demand,
+                      contact=prob.w_contact)

@@ -221,10 +221,11 @@ class _Engine:
 
     def load_properties(self) -> None:
         """sigma_0, K' = sqrt(32/pi) K_Ic and C' = 2 C_L at every box cell, from the layer table (again after
-        the box grows or the grid changes), and the slurry's viscosity ratio and blocked cells (slurry.py; None
-        without one)."""
+        the box grows or the grid changes), and the slurry's viscosity ratio, blocked cells and width floor
+        (slurry.py; None without one)."""
         x, z = self.grid.centres()
-        self.ratio_box, self.blocked_box = (None, None) if self.slurry is None else self.slurry.at(x, z)
+        self.ratio_box, self.blocked_box, self.floor_box = (None, None, None) if self.slurry is None \
+            else self.slurry.at(x, z)
         rock = self.scene.rock
         self.sigma_box = rock.min_stress_at(z)
         self.kprime_box = K_PRIME_FACTOR * rock.toughness_at(z)
@@ -296,10 +297,15 @@ class _Engine:
         closed = g.shut(self.t)[sel] if pinned is None else None   # the last step's contact set
         if closed is not None and source[self.inj] > 0.0:
             closed[self.inj] = False   # the injected fluid opens the perforated cell of a closed fracture
+        contact = None   # without injection, the walls meet on the proppant (slurry.py's floor; never above w_old)
+        if self.floor_box is not None and closed is not None and not source.any():
+            contact = np.minimum(self.floor_box[sel], np.maximum(w_old, 0.0))
+            closed |= (contact > 0.0) & (w_old <= contact)
         if closed is not None and closed.all() and not source.any():   # a closed fracture: nothing moves
             zero = np.zeros(w_old.size)
-            return StepResult(w=zero, p=g["p"][sel].copy(), leaked=zero, demand=zero, iterations=0, converged=True,
-                              residual=zero, work=NewtonWork())
+            return StepResult(w=zero if contact is None else contact.copy(), p=g["p"][sel].copy(), leaked=zero,
+                              demand=zero, iterations=0, converged=True, residual=zero, work=NewtonWork(),
+                              contact=contact)
         if self.num.leakoff_clock:   # with a wetted fraction: the volume leaked per wetted area
             clock = leaked_old if wetted is None else np.divide(leaked_old, wetted, out=np.zeros_like(leaked_old),
                                                                 where=wetted > 0.0)
@@ -308,7 +314,7 @@ class _Engine:
             demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt, filled)
         w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
         prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
-                           demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted, self.closure_width)
+                           demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted, self.closure_width, contact)
         if w_start is not None:
             first = np.where(w_start > 0.0, w_start, start_widths(prob))
         else:
@@ -347,16 +353,18 @@ class _Engine:
         self.t += dt
         self.w_peak = max(self.w_peak, float(res.w.max()))
         shut_in = self.schedule.mean_rate(t_a, self.t) <= 0.0
-        drained = shut_in & (res.w > 0.0) & (res.w < self.closure_width) \
-            & (res.demand >= res.w * self.area) & (g["opened"][sel] < t_a)   # one step to fill a new cell
+        base = 0.0 if res.contact is None else res.contact   # the walls close on the proppant (slurry.py)
+        film = res.w - base
+        drained = shut_in & (film > 0.0) & (film < self.closure_width) \
+            & (res.demand >= film * self.area) & (g["opened"][sel] < t_a)   # one step to fill a new cell
         if pinned is not None:
             drained &= ~pinned
             if drained.any():
                 self.recede()
         w_start = g["w"][sel]
-        emptied = drained | (shut_in & (res.w < 0.0))   # and a width the contact passes left below 0
-        w = np.where(emptied, 0.0, res.w)
-        leaked = res.leaked + np.where(emptied, res.w * self.area, 0.0)   # the film leaks off as the walls meet
+        emptied = drained | (shut_in & (film < 0.0))   # and a width the contact passes left below 0
+        w = np.where(emptied, base, res.w)
+        leaked = res.leaked + np.where(emptied, film * self.area, 0.0)   # the film leaks off as the walls meet
         g["w"][sel] = w
         g["p"][sel] = res.p
         self.distances = None

@@ -11,7 +11,10 @@ viscosity ratio):
 * ``blocked``: cells the front cannot advance into or through (bridged or packed slurry at the tip): a blocked
   active cell opens no neighbour, a blocked inactive cell is not opened (front.cells_to_open's ``blocked``);
 * the tip asymptote (Eq. 33 with the M vertex, front.py) uses mu' times the mean ratio of the fracture's edge
-  cells (``tip_ratio``): one viscosity for the whole front (exact for a uniform slurry).
+  cells (``tip_ratio``): one viscosity for the whole front (exact for a uniform slurry);
+* ``floor`` [m]: the width at which the walls meet the proppant (its grains at close packing). In a step without
+  injection (after shut-in) a cell cannot close below it: newton.py holds it there as a contact cell (its
+  unknown the fluid pressure, the difference to the elastic pressure the grains' load) that leaks no more.
 
 A uniform slurry (the same ratio everywhere, ``outside`` included) is a fluid of viscosity r mu: the run then
 equals the clean-fluid run of that viscosity (tests/fracture/test_slurry.py checks it against the radial
@@ -34,6 +37,7 @@ class Slurry:
     frame: GridFrame
     ratio: np.ndarray
     blocked: np.ndarray
+    floor: np.ndarray | None = None
     outside: float = 1.0
 
     @classmethod
@@ -42,15 +46,16 @@ class Slurry:
         return cls(GridFrame(1.0, 1.0, 0.0, 0.0), np.full((1, 1), float(ratio)), np.zeros((1, 1), bool),
                    outside=float(ratio))
 
-    def at(self, x: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(ratio, blocked) at the points (x, z) (arrays of one shape): the nearest cell's, the clean fluid's
-        (``outside``, False) beyond the frame."""
+    def at(self, x: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """(ratio, blocked, floor) at the points (x, z) (arrays of one shape): the nearest cell's, the clean
+        fluid's (``outside``, False, 0) beyond the frame; floor None without one."""
         nz, nx = self.ratio.shape
         i = np.floor((np.asarray(x) - self.frame.x0) / self.frame.dx + 0.5).astype(int)
         k = np.floor((np.asarray(z) - self.frame.z0) / self.frame.dz + 0.5).astype(int)
         inside = (i >= 0) & (i < nx) & (k >= 0) & (k < nz)
         i, k = np.clip(i, 0, nx - 1), np.clip(k, 0, nz - 1)
-        return np.where(inside, self.ratio[k, i], self.outside), inside & self.blocked[k, i]
+        floor = None if self.floor is None else np.where(inside, self.floor[k, i], 0.0)
+        return np.where(inside, self.ratio[k, i], self.outside), inside & self.blocked[k, i], floor
 
 
 def held_tips(active: np.ndarray, blocked: np.ndarray | None) -> int:
