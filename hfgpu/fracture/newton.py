@@ -394,10 +394,12 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
     """Newton iterations on Eq. 29 until ||dw|| < tolerance ||w|| (Eq. 32; with ``simplified_exit`` also once
     the simplified correction is below it, module docstring), then the contact set is updated
     (cells with w < 0 closed, closed cells whose fluid pressure exceeds sigma + C w opened) and Newton rerun
-    until it settles (at most CONTACT_PASSES times); never raises on failure. ``closed_start``: cells that
-    start closed (the contact set of the previous step: with it, a step whose set does not change needs one
-    Newton pass instead of two). ``preconditioner``: StepResult.preconditioner of an earlier solve on the
-    same active cells and contact set (Newton-Krylov: its SuperLU is tried first instead of a new one)."""
+    until it settles (at most CONTACT_PASSES times; a set still moving is solved once more as it stands, so
+    that the step's residual, hence its volume balance, is converged); never raises on failure.
+    ``closed_start``: cells that start closed (the contact set of the previous step: with it, a step whose set
+    does not change needs one Newton pass instead of two). ``preconditioner``: StepResult.preconditioner of an
+    earlier solve on the same active cells and contact set (Newton-Krylov: its SuperLU is tried first instead
+    of a new one)."""
     x = (start_widths(prob) if w_start is None else w_start).astype(float, copy=True)
     pinned = np.zeros(x.size, bool) if prob.pinned is None else np.isfinite(prob.pinned)
     closed = pinned if closed_start is None else pinned | closed_start
@@ -405,6 +407,7 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
         x[closed] = elastic.apply(np.where(closed, held_width(prob), x))[closed] / elastic.self_stiffness
     iterations = 0
     work = NewtonWork()
+    settled = False
     for _ in range(CONTACT_PASSES):
         x, converged, it, preconditioner = _newton(prob, elastic, x, closed, tolerance, max_iterations, work,
                                                    preconditioner, simplified_exit)
@@ -415,11 +418,16 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
         floor = 0.0 if prob.w_contact is None else prob.w_contact
         to_close = ~closed & (w - floor < -CONTACT_TOLERANCE * float(np.abs(w).max()))
         to_open = closed & ~pinned & (prob.sigma + elastic.apply(w) < p)
-        if not (to_close.any() or to_open.any()):
+        settled = not (to_close.any() or to_open.any())
+        if settled:
             break
         x = np.where(to_close, (p - prob.sigma) / elastic.self_stiffness, np.where(to_open, 0.0, x))
         closed = (closed | to_close) & ~to_open
         preconditioner = None
+    if converged and not settled:   # the set still moved after the last pass: solve on the set it moved to
+        x, converged, it, preconditioner = _newton(prob, elastic, x, closed, tolerance, max_iterations, work,
+                                                   preconditioner, simplified_exit)
+        iterations += it
     r = residual(prob, elastic, x, closed)
     ok = converged and bool(np.all(np.isfinite(r.f)))
     return StepResult(w=r.w, p=r.p, leaked=prob.area * prob.demand * r.g, iterations=iterations, converged=ok,
