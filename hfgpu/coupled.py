@@ -47,7 +47,6 @@ import dataclasses
 import math
 import time as _time
 import warnings
-from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -129,7 +128,8 @@ def proppant_scene(scene: Scene, frame: GridFrame, shape: tuple[int, int], width
 
 class Timings:
     """Wall time [s] per phase (time.perf_counter): fracture, fluid (SIMPLE steps), parcels (particle
-    sub-loops), io (sinks); the rest of a run (scatter, injection, width resampling, set-up) is not split."""
+    sub-loops), io (sinks), and in a two-way run footprint (the clean-fluid pass) and feedback (the slurry
+    handed to the fracture); the rest of a run (scatter, injection, width resampling, set-up) is not split."""
 
     def __init__(self):
         self.seconds = {"fracture": 0.0, "fluid": 0.0, "parcels": 0.0, "io": 0.0}
@@ -310,9 +310,10 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
        one-way fracture), plus ``[coupling] margin`` cells: slurry shortens a fracture, the grid covers it.
     2. The pad: the fracture alone up to the proppant start (clean fluid; as the one-way run).
     3. Every interval [t, t + fracture_every]: the fracture steps over it in the slurry the proppant left at t
-       (viscosity ratios, packed cells' Darcy resistance, bridged cells that stop the front:
-       hfgpu.slurry_feedback), then the proppant steps over it in that interval's geometry (the widths of its
-       two ends, linear in time), then the slurry at t + fracture_every is handed to the fracture.
+       (viscosity ratios, packed cells' Darcy resistance, bridged cells that stop the front, and after shut-in
+       the width at which the walls meet the grains: hfgpu.slurry_feedback), then the proppant steps over it
+       in that interval's geometry (the widths of its two ends, linear in time), then the slurry at
+       t + fracture_every is handed to the fracture.
     4. The summary: as :func:`simulate`'s, plus the tip screen-out (``tip_screen_out_time``: the first interval
        end at which a bridged or packed cell holds the front along the length; ``net_pressure_rise``: the
        largest net pressure after it less the net pressure then, NaN without one) and ``packed_length`` (the
