@@ -247,13 +247,14 @@ class _Engine:
 
     def slurry_faces(self) -> None:
         """The lubrication faces of the active set with the slurry's viscosity ratio (slurry.py), and the tip
-        asymptote's mu' times the edge cells' mean ratio."""
+        asymptote's mu' times the mean ratio of the edge cells the slurry does not block (1 without any)."""
         if self.ratio_box is None:
             self.faces = build_faces(self.ix, self.iz, self.dx, self.dz, self.mu_prime)
             return
         ratio = self.ratio_box[self.rows, self.cols]
         self.faces = build_faces(self.ix, self.iz, self.dx, self.dz, self.mu_prime, ratio)
-        tip_ratio = float(self.ratio_box[edge_cells(self.grid["active"])].mean())
+        moving = edge_cells(self.grid["active"]) & ~self.blocked_box
+        tip_ratio = float(self.ratio_box[moving].mean()) if moving.any() else 1.0
         self.tip = dataclasses.replace(self.tip, mu_prime=self.mu_prime * tip_ratio)
 
     def use_slurry(self, slurry: Slurry) -> None:

@@ -11,7 +11,8 @@ viscosity ratio):
 * ``blocked``: cells the front cannot advance into or through (bridged or packed slurry at the tip): a blocked
   active cell opens no neighbour, a blocked inactive cell is not opened (front.cells_to_open's ``blocked``);
 * the tip asymptote (Eq. 33 with the M vertex, front.py) uses mu' times the mean ratio of the fracture's edge
-  cells (``tip_ratio``): one viscosity for the whole front (exact for a uniform slurry);
+  cells that are not blocked (simulator._Engine.slurry_faces): one viscosity for the whole front (exact for a
+  uniform slurry; a packed bed on the fracture's lower edge, blocked, does not count);
 * ``floor`` [m]: the width at which the walls meet the proppant (its grains at close packing). In a step without
   injection (after shut-in) a cell cannot close below it: newton.py holds it there as a contact cell (its
   unknown the fluid pressure, the difference to the elastic pressure the grains' load) that leaks no more.
