@@ -368,6 +368,7 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
             p_max = max(p_max, p_net)
     proppant = sim.finish(shift)
     warn_screen_out(proppant, params.theta_cp, offset=start)
+    warn_inconsistent_width(proppant)
     proppant["screen_out_time"] += start
     fracture = run.summary()
     packed = packed_cells(sim.snapshot(), params).any(axis=0)
