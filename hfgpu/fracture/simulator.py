@@ -259,7 +259,7 @@ class _Engine:
 
     def use_slurry(self, slurry: Slurry) -> None:
         """Continue with the slurry's fields (two-way coupling, hfgpu.coupled): viscosity ratios, blocked
-        cells."""
+        cells, the width floor after shut-in."""
         self.slurry = slurry
         self.load_properties()
         self.slurry_faces()
