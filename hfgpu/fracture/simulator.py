@@ -62,6 +62,11 @@ continues from the exposure time that volume corresponds to, not from its openin
 (leakoff.carter_demand), so the time it spent dry does not count as exposure and the lost demand is
 not lost for good. Coarsening carries it as a volume (sum of the children / 9).
 
+Slurry (two-way coupling, slurry.py). ``simulate(..., slurry=)`` or ``FractureRun.engine.use_slurry`` between
+``FractureRun.advance`` calls give the engine per-cell viscosity ratios (the lubrication faces' mu'), blocked
+cells the front cannot pass (front.cells_to_open) and, in steps without injection, the width at which the walls
+meet the proppant (newton.py's contact at ``w_contact``). Without one the engine runs as above, bit for bit.
+
 Checkpoints: engine_state.py. What the run reports (balance records aside): views.py.
 """
 
