@@ -1,4 +1,8 @@
-"""The integrated, one-way coupled run (the paper, section 4.3 and Fig. 4): fracture first, proppant on it.
+"""The integrated coupled run (the paper, section 4.3 and Fig. 4): one-way, fracture first and proppant on it
+(:func:`simulate`, below); two-way, the two interval by interval with the slurry acting on the fracture
+(``[coupling] mode = "two-way"``, :func:`simulate_two_way`, which reads like Fig. 4 top to bottom).
+
+One-way:
 
 A scene with ``physics = ["fracture", "proppant"]`` runs
 
@@ -33,7 +37,8 @@ line reports it above 5 % of the injected fluid.
 ``[coupling]`` keys (all optional): ``fracture_every`` (default end_time / 60), ``cell_size`` (one length or
 [dx, dz]; default the fracture cells), ``inlet_inner_radius`` (default 0), ``inlet_radius`` (outer radius of the
 annulus, default 1.5 x the larger proppant cell size: the injection cell and its eight neighbours),
-``proppant_start`` (see above), ``margin`` (cells around the largest footprint, default 1).
+``proppant_start`` (see above), ``margin`` (cells around the largest footprint, default 1), ``mode``
+("one-way", the default, or "two-way").
 """
 
 from __future__ import annotations
@@ -42,22 +47,23 @@ import dataclasses
 import math
 import time as _time
 import warnings
-from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
-from .coupling import FractureHistory, bridging_risk, proppant_frame
+from .coupling import FractureHistory, proppant_frame, screen_out_cells
 from .coupling_config import DEFAULT_INLET_CELLS
 from .errors import SceneError
 from .fracture.mesh import injection_cell_centre
-from .fracture.simulator import simulate as simulate_fracture
+from .fracture.simulator import FractureRun, simulate as simulate_fracture
+from .fracture.slurry import held_tips
 from .io.progress import shifted
 from .io.sink import FractureSink, ProppantSink, ResultsSink
 from .proppant.config import Geometry, Port
 from .proppant.simulator import ProppantSimulation, warn_screen_out
-from .records import FractureSnapshot, GridFrame, ProppantSnapshot, SolidBalanceRecord
+from .records import BalanceRecord, FractureSnapshot, GridFrame, ProppantSnapshot, SolidBalanceRecord
 from .scene import Scene, Schedule
+from .slurry_feedback import packed_cells, slurry_of
 
 def proppant_start_time(scene: Scene) -> float:
     """When the proppant run starts: ``[coupling] proppant_start``, else the start of the first stage that
@@ -120,33 +126,10 @@ def proppant_scene(scene: Scene, frame: GridFrame, shape: tuple[int, int], width
         mesh=dataclasses.replace(scene.mesh, dx=frame.dx, dz=frame.dz))
 
 
-def cell_indices(frame: GridFrame, shape: tuple[int, int], x: np.ndarray, z: np.ndarray) -> tuple:
-    """(k, i) of the cells holding points (x, z), clipped to the grid."""
-    nz, nx = shape
-    i = np.clip(np.floor((np.asarray(x) - frame.x0) / frame.dx + 0.5).astype(int), 0, nx - 1)
-    k = np.clip(np.floor((np.asarray(z) - frame.z0) / frame.dz + 0.5).astype(int), 0, nz - 1)
-    return k, i
-
-
-def screen_out_cells(snap: ProppantSnapshot, factor: float) -> np.ndarray:
-    """Cells holding parcels whose width is below ``factor`` x the largest parcel diameter in the cell
-    (:func:`hfgpu.coupling.bridging_risk` with each cell's own largest grain)."""
-    width = np.asarray(snap.grid["width"], dtype=np.float64)
-    diameter = np.zeros(width.shape)
-    p = snap.parcels
-    if len(p["x"]):
-        k, i = cell_indices(snap.frame, width.shape, p["x"], p["z"])
-        np.maximum.at(diameter, (k, i), 2.0 * np.asarray(p["radius"]))
-    held = diameter > 0.0
-    out = np.zeros(width.shape, dtype=bool)
-    if held.any():
-        out[held] = bridging_risk(width[held], diameter[held], factor)
-    return out
-
-
 class Timings:
     """Wall time [s] per phase (time.perf_counter): fracture, fluid (SIMPLE steps), parcels (particle
-    sub-loops), io (sinks); the rest of a run (scatter, injection, width resampling, set-up) is not split."""
+    sub-loops), io (sinks), and in a two-way run footprint (the clean-fluid pass) and feedback (the slurry
+    handed to the fracture); the rest of a run (scatter, injection, width resampling, set-up) is not split."""
 
     def __init__(self):
         self.seconds = {"fracture": 0.0, "fluid": 0.0, "parcels": 0.0, "io": 0.0}
@@ -163,16 +146,35 @@ class Timings:
 
 
 class _FractureTee:
-    """Sink of the fracture phase: records go on to ``sink``; snapshots are also kept in ``snapshots``."""
+    """Sink of the fracture phase: records go on to ``sink``; snapshots are also kept in ``snapshots``, the
+    last balance record in ``last``."""
 
     def __init__(self, sink: FractureSink, timings: Timings):
         self.snapshots: list[FractureSnapshot] = []
+        self.last: BalanceRecord | None = None
         self._snap = timings.wrap("io", sink.fracture_snapshot)
-        self.fracture_balance = timings.wrap("io", sink.fracture_balance)
+        self._balance = timings.wrap("io", sink.fracture_balance)
 
     def fracture_snapshot(self, snap: FractureSnapshot) -> None:
         self.snapshots.append(snap)
         self._snap(snap)
+
+    def fracture_balance(self, record: BalanceRecord) -> None:
+        self.last = record
+        self._balance(record)
+
+
+class _Snapshots:
+    """A fracture sink that keeps the snapshots only (the clean-fluid pass of a two-way run)."""
+
+    def __init__(self):
+        self.snapshots: list[FractureSnapshot] = []
+
+    def fracture_snapshot(self, snap: FractureSnapshot) -> None:
+        self.snapshots.append(snap)
+
+    def fracture_balance(self, record: BalanceRecord) -> None:
+        pass
 
 
 class _ProppantShift:
@@ -233,7 +235,8 @@ def warn_inconsistent_width(summary: dict) -> None:
 
 def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] | None = None,
              timings: Timings | None = None, checkpoint=None, resume: dict | None = None) -> dict:
-    """Run the coupled scene (module docstring): fracture, then proppant on the fracture history.
+    """Run the coupled scene (module docstring): fracture, then proppant on the fracture history (a two-way
+    scene goes to :func:`simulate_two_way`).
 
     ``sink`` gets the fracture and the proppant records (proppant times on the scene's clock); ``progress(t)``
     is called through both phases; ``timings`` (optional) collects wall time per phase. Returns a summary:
@@ -246,6 +249,8 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
     bridging counters), "proppant": <the proppant model's>}; ``resume`` is such a state plus
     "fracture_snapshots", the fracture snapshots the results file kept (the history before the checkpoint).
     """
+    if scene.coupling.mode == "two-way":
+        return simulate_two_way(scene, sink, progress, timings)
     timings = timings if timings is not None else Timings()
     start = proppant_start_time(scene)
     cfg = scene.coupling
@@ -293,5 +298,86 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
     summary.update(proppant_start=start, proppant_nx=shape[1], proppant_nz=shape[0], proppant_dx=frame.dx,
                    proppant_dz=frame.dz, screen_out_cells=shift.flagged, screen_out_cells_max=shift.flagged_max,
                    screen_out_first_time=shift.first_time, time=scene.run.end_time)
+    summary.update({f"time_{k}": v for k, v in timings.seconds.items()})
+    return summary
+
+
+def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] | None = None,
+                     timings: Timings | None = None) -> dict:
+    """The two-way coupled run (``[coupling] mode = "two-way"``): the paper's Fig. 4 with the arrow back.
+
+    1. The proppant grid: the footprint of the fracture pumped with clean fluid (a pass without output, the
+       one-way fracture), plus ``[coupling] margin`` cells: slurry shortens a fracture, the grid covers it.
+    2. The pad: the fracture alone up to the proppant start (clean fluid; as the one-way run).
+    3. Every interval [t, t + fracture_every]: the fracture steps over it in the slurry the proppant left at t
+       (viscosity ratios, packed cells' Darcy resistance, bridged cells that stop the front, and after shut-in
+       the width at which the walls meet the grains: hfgpu.slurry_feedback), then the proppant steps over it
+       in that interval's geometry (the widths of its two ends, linear in time), then the slurry at
+       t + fracture_every is handed to the fracture.
+    4. The summary: as :func:`simulate`'s, plus the tip screen-out (``tip_screen_out_time``: the first interval
+       end at which a bridged or packed cell holds the front along the length; ``net_pressure_rise``: the
+       largest net pressure after it less the net pressure then, NaN without one) and ``packed_length`` (the
+       length of fracture whose column holds a packed cell at the end).
+
+    No checkpoints (a two-way run restarts from the beginning); ``progress(t)`` follows the fracture.
+    """
+    timings = timings if timings is not None else Timings()
+    timings.seconds.update(footprint=0.0, feedback=0.0)
+    cfg, params = scene.coupling, scene.proppant.params
+    fracture_scene = scene.replace(output=dataclasses.replace(scene.output, every=cfg.fracture_every))
+    t0 = _time.perf_counter()
+    clean = _Snapshots()
+    simulate_fracture(fracture_scene, clean)
+    history = FractureHistory(clean.snapshots)
+    start = late_start(scene, proppant_start_time(scene), float(history.times[0]))
+    frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=injection_cell_centre(scene))
+    timings.seconds["footprint"] += _time.perf_counter() - t0
+
+    tee = _FractureTee(sink, timings)
+    run = FractureRun(fracture_scene, tee, progress)
+
+    def advance_fracture(until: float) -> None:
+        t_a, io = _time.perf_counter(), timings.seconds["io"]
+        run.advance(until)
+        timings.seconds["fracture"] += _time.perf_counter() - t_a - (timings.seconds["io"] - io)
+
+    advance_fracture(start)
+    geometry = {"width": FractureHistory(tee.snapshots).width_field(frame, shape, cfg.min_width)}
+    sim = ProppantSimulation(proppant_scene(scene, frame, shape, geometry["width"](start)[0], start),
+                             width_field=lambda t: geometry["width"](t + start))
+    sim.watch.offset = start
+    sim.solver.step = timings.wrap("fluid", sim.solver.step)
+    sim.engine.substeps = timings.wrap("parcels", sim.engine.substeps)
+    shift = _ProppantShift(sink, start, params.bridging_factor, timings)
+    every = cfg.fracture_every
+    ends = [every * k for k in range(int(math.floor(start / every + 1e-9)) + 1,
+                                     int(math.floor(scene.run.end_time / every + 1e-9)) + 1)]
+    ends = sorted({t for t in ends if t > start} | {scene.run.end_time})
+    t_screen_out, p_screen_out, p_max = math.nan, math.nan, -math.inf
+    for t_next in ends:
+        advance_fracture(t_next)
+        geometry["width"] = FractureHistory(tee.snapshots).width_field(frame, shape, cfg.min_width)
+        sim.advance(t_next - start, shift)
+        t_a = _time.perf_counter()
+        run.engine.use_slurry(slurry_of(sim.snapshot(), params))
+        timings.seconds["feedback"] += _time.perf_counter() - t_a
+        p_net = tee.last.net_pressure
+        if math.isnan(t_screen_out) and held_tips(run.engine.grid["active"], run.engine.blocked_box):
+            t_screen_out, p_screen_out = t_next, p_net
+        if not math.isnan(t_screen_out):
+            p_max = max(p_max, p_net)
+    proppant = sim.finish(shift)
+    warn_screen_out(proppant, params.theta_cp, offset=start)
+    warn_inconsistent_width(proppant)
+    proppant["screen_out_time"] += start
+    fracture = run.summary()
+    packed = packed_cells(sim.snapshot(), params).any(axis=0)
+    summary = {f"fracture_{k}": v for k, v in fracture.items()}
+    summary.update({f"proppant_{k}": v for k, v in proppant.items()}, proppant_time=proppant["time"] + start)
+    summary.update(proppant_start=start, proppant_nx=shape[1], proppant_nz=shape[0], proppant_dx=frame.dx,
+                   proppant_dz=frame.dz, screen_out_cells=shift.flagged, screen_out_cells_max=shift.flagged_max,
+                   screen_out_first_time=shift.first_time, time=scene.run.end_time,
+                   tip_screen_out_time=t_screen_out, net_pressure_rise=p_max - p_screen_out,
+                   packed_length=float(packed.sum()) * frame.dx)
     summary.update({f"time_{k}": v for k, v in timings.seconds.items()})
     return summary

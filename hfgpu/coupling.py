@@ -12,12 +12,14 @@ leak-off fields on that grid (the moving walls w of Eq. 7-8 and the sink s_l of 
 * interpolates linearly in time between the two snapshots that bracket t (zero before the first snapshot,
   the last one after it); a cell is open when its interpolated width is > 0;
 * builds the fixed proppant grid (:func:`proppant_frame`) and flags cells where proppant would bridge
-  (:func:`bridging_risk`, reported only: the coupling is one-way).
+  (:func:`bridging_risk`, :func:`screen_out_cells`: reported by a one-way run, fed back to the fracture by a
+  two-way run, hfgpu.slurry_feedback).
 
 Public API: ``FractureHistory(snapshots)``, ``FractureHistory.from_results(path)``, ``history.times``,
 ``history.fields_at(t, frame, shape, min_width=0)``, ``history.width_field(frame, shape, min_width=0)``,
 ``history.opening_time_on(frame, shape)``, ``history.injection_point()``,
-``proppant_frame(history, cell_size=None, margin=1, source=None)``, ``bridging_risk(width, diameter, factor)``.
+``proppant_frame(history, cell_size=None, margin=1, source=None)``, ``bridging_risk(width, diameter, factor)``,
+``cell_indices(frame, shape, x, z)``, ``screen_out_cells(snapshot, factor)``.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .records import FractureSnapshot, GridFrame
+from .records import FractureSnapshot, GridFrame, ProppantSnapshot
 
 Shape = tuple[int, int]
 
@@ -239,11 +241,34 @@ def proppant_frame(history: FractureHistory, cell_size: float | tuple[float, flo
 
 def bridging_risk(width: np.ndarray, diameter: float | np.ndarray, factor: float) -> np.ndarray:
     """Open cells (width > 0) whose width is below factor x diameter: where packed proppant would bridge
-    (the criterion of the parcels' push, hfgpu.proppant.params ``bridging_factor``; a screen-out diagnostic,
-    not fed back to the fracture). ``diameter``: one grain size, or one per cell (same shape as width)."""
+    (the criterion of the parcels' push, hfgpu.proppant.params ``bridging_factor``). ``diameter``: one grain size, or one per cell (same shape as width)."""
     for name, value in (("diameter", diameter), ("factor", factor)):
         value = np.asarray(value, dtype=np.float64)
         if not np.all(np.isfinite(value) & (value > 0.0)):
             raise ValueError(f"bridging_risk: {name} = {value}; must be positive finite number(s)")
     width = np.asarray(width, dtype=np.float64)
     return (width > 0.0) & (width < factor * np.asarray(diameter, dtype=np.float64))
+
+
+def cell_indices(frame: GridFrame, shape: tuple[int, int], x: np.ndarray, z: np.ndarray) -> tuple:
+    """(k, i) of the cells holding points (x, z), clipped to the grid."""
+    nz, nx = shape
+    i = np.clip(np.floor((np.asarray(x) - frame.x0) / frame.dx + 0.5).astype(int), 0, nx - 1)
+    k = np.clip(np.floor((np.asarray(z) - frame.z0) / frame.dz + 0.5).astype(int), 0, nz - 1)
+    return k, i
+
+
+def screen_out_cells(snap: ProppantSnapshot, factor: float) -> np.ndarray:
+    """Cells holding parcels whose width is below ``factor`` x the largest parcel diameter in the cell
+    (:func:`hfgpu.coupling.bridging_risk` with each cell's own largest grain)."""
+    width = np.asarray(snap.grid["width"], dtype=np.float64)
+    diameter = np.zeros(width.shape)
+    p = snap.parcels
+    if len(p["x"]):
+        k, i = cell_indices(snap.frame, width.shape, p["x"], p["z"])
+        np.maximum.at(diameter, (k, i), 2.0 * np.asarray(p["radius"]))
+    held = diameter > 0.0
+    out = np.zeros(width.shape, dtype=bool)
+    if held.any():
+        out[held] = bridging_risk(width[held], diameter[held], factor)
+    return out

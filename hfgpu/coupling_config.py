@@ -14,6 +14,11 @@ DEFAULT_FRACTURE_SNAPSHOTS = 60
 DEFAULT_INLET_CELLS = 1.5
 #: Default ``[coupling] min_width`` [m]: narrower cells are closed for the proppant run (parse_coupling).
 DEFAULT_MIN_WIDTH = 10e-6
+#: ``[coupling] mode``: "one-way" (fracture first, proppant on its history) or "two-way" (the fracture sees the
+#: slurry interval by interval); hfgpu.coupled.
+MODES = ("one-way", "two-way")
+#: ``[coupling] mode`` when the scene does not give it (docs/coupling.md has the measurements behind it).
+DEFAULT_MODE = "one-way"
 
 
 @dataclass(frozen=True)
@@ -27,11 +32,17 @@ class CouplingConfig:
     proppant_start: float | None = None
     margin: int = 1
     min_width: float = DEFAULT_MIN_WIDTH
+    mode: str = DEFAULT_MODE
 
 
-def parse_coupling(t: Table, end_time: float, refinement: float = 1.0) -> CouplingConfig:
+def parse_coupling(t: Table, end_time: float, refinement: float = 1.0,
+                   front_tracking: str | None = "cells") -> CouplingConfig:
     """Read ``[coupling]`` (every key optional) into a :class:`CouplingConfig`; the proppant cells in use are
     ``cell_size`` / ``refinement`` (``[mesh] refinement``, as the fracture cells).
+
+    ``mode``: "one-way" or "two-way" (:data:`MODES`); "two-way" needs the whole-cell front (``[fracture]
+    front_tracking``, given here; None when [fracture] did not parse): bridged cells stop it
+    (hfgpu.fracture.slurry).
 
     ``min_width``: proppant cells narrower than this are closed for the proppant run. A cell that opens between
     two fracture snapshots passes through every width from 0 (the width is linear in time), and the fluid must
@@ -53,6 +64,10 @@ def parse_coupling(t: Table, end_time: float, refinement: float = 1.0) -> Coupli
     start = t.quantity("proppant_start", "time", None, minimum=0.0, maximum=end_time, exclusive_maximum=True)
     margin = t.integer("margin", 1, minimum=0)
     min_width = t.quantity("min_width", "length", DEFAULT_MIN_WIDTH, minimum=0.0)
+    mode = t.choice("mode", MODES, DEFAULT_MODE)
+    if mode == "two-way" and front_tracking not in ("cells", None):
+        raise SceneError(t.key_path("mode"), mode, 'two-way coupling needs [fracture] front_tracking = "cells"')
     t.finish()
     return CouplingConfig(fracture_every=every, cell_size=cell_size, inlet_inner_radius=inner,
-                          inlet_radius=outer, proppant_start=start, margin=margin, min_width=min_width)
+                          inlet_radius=outer, proppant_start=start, margin=margin, min_width=min_width,
+                          mode=mode)

@@ -2,7 +2,8 @@
 
 Only what the scene requires is imported: physics ["fracture"] loads ``hfgpu.fracture.simulator`` and
 no proppant code, ["proppant"] loads ``hfgpu.proppant.simulator`` and no fracture code; both at once run the
-one-way coupled model of ``hfgpu.coupled`` (fracture first, proppant on its history).
+coupled model of ``hfgpu.coupled`` (one-way: fracture first, proppant on its history; two-way: interval by
+interval, the fracture in the slurry).
 
 Checkpoints: the simulator gets a :class:`hfgpu.io.checkpoint.Checkpointer` writing into the results file;
 ``resume=True`` continues a killed (or failed) run from the checkpoint in its results file.

@@ -425,8 +425,9 @@ def _parse(data: dict, source: str) -> Scene:
         else:
             from .coupling_config import parse_coupling
 
-            coupling = sections(("coupling",), lambda: parse_coupling(top.table("coupling", {}), run.end_time,
-                                                                       mesh.refinement))
+            coupling = sections(("coupling",), lambda: parse_coupling(
+                top.table("coupling", {}), run.end_time, mesh.refinement,
+                fracture.front_tracking if fracture is not None else None))
     elif top.has("coupling"):
         top.raw("coupling")
         sections.errors.append(SceneError("coupling", "(table)",

@@ -198,6 +198,16 @@ def units_note(scene: Scene) -> str:
             "set [output] units to choose)")
 
 
+def coupling_line(scene: Scene) -> str:
+    """Which coupling a coupled scene runs: ``[coupling] mode`` as given, or the default and that it is one."""
+    from .coupling_config import DEFAULT_MODE
+
+    given = _document(scene).get("coupling")
+    if isinstance(given, dict) and "mode" in given:
+        return f"coupling: {scene.coupling.mode} ([coupling] mode)"
+    return f"coupling: {DEFAULT_MODE} (the default; set [coupling] mode = \"one-way\" or \"two-way\" to choose)"
+
+
 def describe(scene: Scene, name: str) -> str:
     """The lines ``hfgpu check`` prints on stdout for a valid scene, in its output units."""
     from .io.summary import schedule_table
@@ -209,6 +219,8 @@ def describe(scene: Scene, name: str) -> str:
     lines = [f"{name}: ok; physics {', '.join(scene.run.physics)}, end time {format_number(scene.run.end_time)} s, "
              f"cells {cells}, output every {format_number(scene.output.every)} s, {units_note(scene)}",
              knob_report(scene, system)]
+    if scene.coupling is not None:
+        lines.append(coupling_line(scene))
     if scene.injection is not None:
         lines.append(schedule_table(scene, system))
     expected = expected_report(scene, system)

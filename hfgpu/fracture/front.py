@@ -143,8 +143,10 @@ def split_by_direction(values: np.ndarray, masks: list[np.ndarray]) -> list[np.n
 
 
 def cells_to_open(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndarray, k_prime: np.ndarray,
-                  c_prime: np.ndarray, reached: np.ndarray, t: float, dx: float, dz: float):
-    """Inactive cells whose tip element satisfies the front criterion (Eq. 33) at s = h/2.
+                  c_prime: np.ndarray, reached: np.ndarray, t: float, dx: float, dz: float,
+                  blocked: np.ndarray | None = None):
+    """Inactive cells whose tip element satisfies the front criterion (Eq. 33) at s = h/2; with ``blocked``
+    (bridged slurry, fracture/slurry.py) neither a blocked tip element opens a cell nor a blocked cell opens.
 
     Returns a boolean mask of cells to open and their tip speeds V_T = d / (t - t_parent) (Eq. 34), the
     fastest over the triggering parents (NaN where nothing opens). ``reached`` holds the times the front
@@ -159,12 +161,17 @@ def cells_to_open(model: TipModel, active: np.ndarray, w: np.ndarray, p: np.ndar
         h = dz if dk else dx
         ok = np.zeros_like(active)
         ok[tips] = w[tips] >= w_dir
+        if blocked is not None:
+            ok &= ~blocked
         # candidate = the cell on the (dk, di) side of a triggering tip element
         cand = shift(ok, dk, di, False) & ~active
         parent_time = shift(reached, dk, di, np.nan)
         vt = h / np.maximum(t - parent_time, 1e-300)
         speed = np.where(cand, np.fmax(speed, vt), speed)
         to_open |= cand
+    if blocked is not None:
+        to_open &= ~blocked
+        speed = np.where(to_open, speed, np.nan)
     return to_open, speed
 
 

@@ -114,7 +114,8 @@ class CellFront:
         """Open the cells the front criterion selects (Eq. 33) and record the tip speed (Eq. 34)."""
         g = engine.grid
         to_open, speed = cells_to_open(engine.tip, g["active"], g["w"], g["p"], engine.kprime_box,
-                                       engine.cprime_box, g["reached"], engine.t, engine.dx, engine.dz)
+                                       engine.cprime_box, g["reached"], engine.t, engine.dx, engine.dz,
+                                       engine.blocked_box)
         if not to_open.any():
             return
         g.fields["active"] = g["active"] | to_open

@@ -20,7 +20,9 @@ How each front gives f (``filled_fraction``):
   closed cells (capped at one cell, as the front summary). Its f is the exact part of the cell behind the
   straight front at distance s along the outward normal n, n the normalised sum of the directions of those
   sides (tip_cells.wetted_fraction: f = 1/2 + s / h on a side of a straight front, the diagonal cut in a
-  corner); f = 1 in cells with no closed neighbour. A fully open rectangle (s >= one cell at its edges)
+  corner); where those directions cancel (closed cells on opposite sides only: a strip one cell across), the
+  front runs at +-s about the centre and f = min(2 s / h, 1) across the strip (the product of both axes for a
+  cell closed all round); f = 1 in cells with no closed neighbour. A fully open rectangle (s >= one cell at its edges)
   gives exactly its own area. The same inverted distances give the front summary's radius, so the area and
   the front agree (``python bench/bench_fracture.py --cases long`` prints both radii's errors).
 
@@ -55,16 +57,21 @@ def filled_fraction(mode: str, active: np.ndarray, fill: np.ndarray, distances: 
     if mode == "subgrid":
         return np.where(active, np.clip(fill, 0.0, 1.0), 0.0)
     nx, nz = np.zeros(active.shape), np.zeros(active.shape)
+    across_x, across_z = np.zeros(active.shape, bool), np.zeros(active.shape, bool)
     reach = np.full(active.shape, np.nan)
     for (dk, di), s in zip(DIRECTIONS, distances):
         faces = np.isfinite(s) & active
         nx, nz = nx + di * faces, nz + dk * faces
+        across_x, across_z = (across_x | faces, across_z) if di else (across_x, across_z | faces)
         reach = np.fmax(reach, np.where(faces, s, np.nan))
     edge = np.isfinite(reach)
-    norm = np.where(edge, np.hypot(nx, nz), 1.0)
+    strip = edge & (nx == 0.0) & (nz == 0.0)   # the front on opposite sides only: a strip one cell across
+    norm = np.where(edge & ~strip, np.hypot(nx, nz), 1.0)
     advance = np.where(edge, np.clip(reach, 0.0, max(dx, dz)), 0.0)
-    edge_fraction = wetted_fraction(advance, nx / norm, nz / norm, dx, dz)
-    return np.where(edge, edge_fraction, np.where(active, 1.0, 0.0))
+    edge_fraction = wetted_fraction(advance, np.where(strip, 1.0, nx / norm), nz / norm, dx, dz)
+    across = (np.where(across_x, np.minimum(2.0 * advance / dx, 1.0), 1.0)
+              * np.where(across_z, np.minimum(2.0 * advance / dz, 1.0), 1.0))   # the strip: +-s about the centre
+    return np.where(strip, across, np.where(edge, edge_fraction, np.where(active, 1.0, 0.0)))
 
 
 def footprint(fraction: np.ndarray, dx: float, dz: float) -> dict[str, float]:

@@ -5,8 +5,9 @@ flux through the face between active cells P and E is
 
     T_PE (p_E - p_P),   T_PE = (w_P + w_E)^3 / (8 mu') * (face length / centre distance),
 
-i.e. the face opening is the arithmetic mean of the two cells (Eq. 29). Faces towards inactive cells carry
-no flux, and so do faces of closed cells (w <= 0: the positive part of w enters the conductance, smoothed
+i.e. the face opening is the arithmetic mean of the two cells (Eq. 29); with a slurry (fracture/slurry.py) mu'
+is the face's, mu' r_PE with r_PE = (r_P + r_E) / 2 the mean of the two cells' viscosity ratios. Faces
+towards inactive cells carry no flux, and so do faces of closed cells (w <= 0: the positive part of w enters the conductance, smoothed
 over a width delta much smaller than the opening, 1e-3 of the largest, so Newton sees no kink). ``Faces`` holds the face list of the active set; ``divergence_matrix`` assembles the sparse
 operator L(w) with (L p)_P = sum_faces T_PE (p_E - p_P), so that volume is conserved exactly: the columns
 of L sum to zero.
@@ -30,8 +31,10 @@ class Faces:
     g: np.ndarray
 
 
-def build_faces(ix: np.ndarray, iz: np.ndarray, dx: float, dz: float, mu_prime: float) -> Faces:
-    """Faces between 4-neighbouring active cells (ix, iz): x-faces get dz/dx, z-faces dx/dz (Eq. 29)."""
+def build_faces(ix: np.ndarray, iz: np.ndarray, dx: float, dz: float, mu_prime: float,
+                ratio: np.ndarray | None = None) -> Faces:
+    """Faces between 4-neighbouring active cells (ix, iz): x-faces get dz/dx, z-faces dx/dz (Eq. 29); with
+    ``ratio`` (each active cell's mu_eff / mu), mu' of a face is mu' (r_a + r_b) / 2."""
     index = {(int(i), int(k)): n for n, (i, k) in enumerate(zip(ix, iz))}
     a, b, g = [], [], []
     for n, (i, k) in enumerate(zip(ix.tolist(), iz.tolist())):
@@ -41,8 +44,9 @@ def build_faces(ix: np.ndarray, iz: np.ndarray, dx: float, dz: float, mu_prime: 
         south = index.get((i, k + 1))
         if south is not None:
             a.append(n), b.append(south), g.append(dx / dz)
-    return Faces(np.array(a, dtype=np.int64), np.array(b, dtype=np.int64),
-                 np.array(g, dtype=float) / (8.0 * mu_prime))
+    a, b = np.array(a, dtype=np.int64), np.array(b, dtype=np.int64)
+    mu_face = mu_prime if ratio is None else mu_prime * 0.5 * (ratio[a] + ratio[b])
+    return Faces(a, b, np.array(g, dtype=float) / (8.0 * mu_face))
 
 
 def positive_part(w: np.ndarray, delta: float) -> tuple[np.ndarray, np.ndarray]:

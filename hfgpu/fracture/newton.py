@@ -102,6 +102,8 @@ class StepProblem:
     w_floor: float = 0.0      # the engine's closure width [m]: a face between two closed cells conducts as an
     #                           aperture of 2 w_floor (the walls in contact still pass pressure, so a closed
     #                           region's pressures stay determined); Newton's convergence test floors ||w|| there
+    w_contact: np.ndarray | None = None   # width at which the walls meet, per cell (a proppant pack's: slurry.py);
+    #                                       None: 0. The fluid below it does not leak (leak_fraction)
 
 
 @dataclass
@@ -124,6 +126,7 @@ class StepResult:
     work: NewtonWork          # the step's linear-algebra work (all contact passes)
     preconditioner: Any = None   # Newton-Krylov: the last preconditioner, for a next solve on the same cells
     demand: np.ndarray | None = None   # Carter's demand per cell over the step [m^3] (leaked: its ramped part)
+    contact: np.ndarray | None = None  # the step's w_contact (StepProblem)
 
 
 class Elasticity:
@@ -141,8 +144,11 @@ class Elasticity:
 
 
 def held_width(prob: StepProblem) -> np.ndarray | float:
-    """Width of a cell whose unknown is its pressure: the prescribed width of a pinned cell, 0 (contact)."""
-    return 0.0 if prob.pinned is None else np.nan_to_num(prob.pinned, nan=0.0)
+    """Width of a cell whose unknown is its pressure: the prescribed width of a pinned cell, the contact width
+    (0, or ``w_contact``)."""
+    if prob.pinned is not None:
+        return np.nan_to_num(prob.pinned, nan=0.0)
+    return 0.0 if prob.w_contact is None else prob.w_contact
 
 
 def _split(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray | None):
@@ -157,8 +163,9 @@ def _split(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.nda
 
 def leak_fraction(prob: StepProblem, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The fraction of a cell's Carter demand it leaks and its derivative: the positivity ramp g(w)
-    (leakoff.available_fraction) times the cell's wetted fraction."""
-    g, dg = available_fraction(w, prob.w_eps)
+    (leakoff.available_fraction) times the cell's wetted fraction; with ``w_contact`` g(w - w_contact): the
+    fluid held in a proppant pack does not leak."""
+    g, dg = available_fraction(w if prob.w_contact is None else w - prob.w_contact, prob.w_eps)
     return (g, dg) if prob.wetted is None else (g * prob.wetted, dg * prob.wetted)
 
 
@@ -387,10 +394,12 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
     """Newton iterations on Eq. 29 until ||dw|| < tolerance ||w|| (Eq. 32; with ``simplified_exit`` also once
     the simplified correction is below it, module docstring), then the contact set is updated
     (cells with w < 0 closed, closed cells whose fluid pressure exceeds sigma + C w opened) and Newton rerun
-    until it settles (at most CONTACT_PASSES times); never raises on failure. ``closed_start``: cells that
-    start closed (the contact set of the previous step: with it, a step whose set does not change needs one
-    Newton pass instead of two). ``preconditioner``: StepResult.preconditioner of an earlier solve on the
-    same active cells and contact set (Newton-Krylov: its SuperLU is tried first instead of a new one)."""
+    until it settles (at most CONTACT_PASSES times; a set still moving is solved once more as it stands, so
+    that the step's residual, hence its volume balance, is converged); never raises on failure.
+    ``closed_start``: cells that start closed (the contact set of the previous step: with it, a step whose set
+    does not change needs one Newton pass instead of two). ``preconditioner``: StepResult.preconditioner of an
+    earlier solve on the same active cells and contact set (Newton-Krylov: its SuperLU is tried first instead
+    of a new one)."""
     x = (start_widths(prob) if w_start is None else w_start).astype(float, copy=True)
     pinned = np.zeros(x.size, bool) if prob.pinned is None else np.isfinite(prob.pinned)
     closed = pinned if closed_start is None else pinned | closed_start
@@ -398,6 +407,7 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
         x[closed] = elastic.apply(np.where(closed, held_width(prob), x))[closed] / elastic.self_stiffness
     iterations = 0
     work = NewtonWork()
+    settled = False
     for _ in range(CONTACT_PASSES):
         x, converged, it, preconditioner = _newton(prob, elastic, x, closed, tolerance, max_iterations, work,
                                                    preconditioner, simplified_exit)
@@ -405,14 +415,21 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
         if not converged:
             break
         w, p = _split(prob, elastic, x, closed)
-        to_close = ~closed & (w < -CONTACT_TOLERANCE * float(np.abs(w).max()))
+        floor = 0.0 if prob.w_contact is None else prob.w_contact
+        to_close = ~closed & (w - floor < -CONTACT_TOLERANCE * float(np.abs(w).max()))
         to_open = closed & ~pinned & (prob.sigma + elastic.apply(w) < p)
-        if not (to_close.any() or to_open.any()):
+        settled = not (to_close.any() or to_open.any())
+        if settled:
             break
         x = np.where(to_close, (p - prob.sigma) / elastic.self_stiffness, np.where(to_open, 0.0, x))
         closed = (closed | to_close) & ~to_open
         preconditioner = None
+    if converged and not settled:   # the set still moved after the last pass: solve on the set it moved to
+        x, converged, it, preconditioner = _newton(prob, elastic, x, closed, tolerance, max_iterations, work,
+                                                   preconditioner, simplified_exit)
+        iterations += it
     r = residual(prob, elastic, x, closed)
     ok = converged and bool(np.all(np.isfinite(r.f)))
     return StepResult(w=r.w, p=r.p, leaked=prob.area * prob.demand * r.g, iterations=iterations, converged=ok,
-                      residual=r.f, work=work, preconditioner=preconditioner, demand=prob.area * prob.demand)
+                      residual=r.f, work=work, preconditioner=preconditioner, demand=prob.area * prob.demand,
+                      contact=prob.w_contact)

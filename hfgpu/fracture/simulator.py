@@ -62,11 +62,17 @@ continues from the exposure time that volume corresponds to, not from its openin
 (leakoff.carter_demand), so the time it spent dry does not count as exposure and the lost demand is
 not lost for good. Coarsening carries it as a volume (sum of the children / 9).
 
+Slurry (two-way coupling, slurry.py). ``simulate(..., slurry=)`` or ``FractureRun.engine.use_slurry`` between
+``FractureRun.advance`` calls give the engine per-cell viscosity ratios (the lubrication faces' mu'), blocked
+cells the front cannot pass (front.cells_to_open) and, in steps without injection, the width at which the walls
+meet the proppant (newton.py's contact at ``w_contact``). Without one the engine runs as above, bit for bit.
+
 Checkpoints: engine_state.py. What the run reports (balance records aside): views.py.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Callable
 
@@ -81,7 +87,7 @@ from .coarsen import coarse_grid, coarsen
 from .config import FractureNumerics
 from .elasticity import ElasticityOperator
 from .engine_state import engine_state, restore_engine
-from .front import TipModel
+from .front import TipModel, edge_cells
 from .front_cells import CellFront
 from .front_strategy import front_strategy
 from .interpolate import StepEnds
@@ -89,6 +95,7 @@ from .leakoff import carter_demand, carter_volume
 from .lubrication import build_faces
 from .mesh import GROW, Grid, injection_cell_centre
 from .newton import drained_start, Elasticity, NewtonWork, StepProblem, StepResult, solve_step, start_widths
+from .slurry import Slurry
 from .solver_choice import use_dense
 from .views import View, front_extents, geometry, snapshot
 
@@ -154,15 +161,18 @@ class _Engine:
     """Mutable state of one run (grid fields, active-set systems, counters) and the implicit step on it; the
     front strategy (``front_tracking``) moves the front, views.py reports, engine_state.py checkpoints."""
 
-    def __init__(self, scene, numerics: FractureNumerics):
-        self.scene, self.num = scene, numerics
+    def __init__(self, scene, numerics: FractureNumerics, slurry: Slurry | None = None):
+        self.scene, self.num, self.slurry = scene, numerics, slurry
         rock, inj = scene.rock, scene.injection
         self.dx, self.dz = scene.mesh.dx, scene.mesh.dz
         self.area = self.dx * self.dz
         self.e_prime = rock.plane_strain_modulus
         self.mu_prime = 12.0 * scene.fluid.viscosity
+        mu_start = self.mu_prime   # the start (start_time, the tip) in the slurry at the perforation
+        if slurry is not None:
+            mu_start *= float(slurry.at(*injection_cell_centre(scene))[0])
         self.schedule = inj.schedule
-        self.tip = TipModel(self.e_prime, self.mu_prime, numerics.tip_asymptote, numerics.tip_velocity)
+        self.tip = TipModel(self.e_prime, mu_start, numerics.tip_asymptote, numerics.tip_velocity)
         self.front_tracking = front_strategy(numerics.front_tracking)
         self.pumping = True   # the run starts while pumping (start_time); step() follows the schedule
         self.op = ElasticityOperator(self.dx, self.dz, self.e_prime)
@@ -173,7 +183,7 @@ class _Engine:
         self.load_properties()
         k0 = K_PRIME_FACTOR * float(rock.toughness_at(np.array(inj.depth)))
         c0 = 2.0 * float(rock.leakoff_at(np.array(inj.depth)))
-        self.t0, power = start_time(self.schedule, self.e_prime, self.mu_prime, k0, c0, r0)
+        self.t0, power = start_time(self.schedule, self.e_prime, mu_start, k0, c0, r0)
         if self.t0 >= 0.5 * self.schedule.end or self.schedule.rate(self.t0) <= 0.0:
             raise SceneError("fracture.initial_radius_cells", numerics.initial_radius_cells,
                              f"the starting fracture ({r0:.3g} m) would take "
@@ -216,8 +226,11 @@ class _Engine:
 
     def load_properties(self) -> None:
         """sigma_0, K' = sqrt(32/pi) K_Ic and C' = 2 C_L at every box cell, from the layer table (again after
-        the box grows or the grid changes)."""
-        _, z = self.grid.centres()
+        the box grows or the grid changes), and the slurry's viscosity ratio, blocked cells and width floor
+        (slurry.py; None without one)."""
+        x, z = self.grid.centres()
+        self.ratio_box, self.blocked_box, self.floor_box = (None, None, None) if self.slurry is None \
+            else self.slurry.at(x, z)
         rock = self.scene.rock
         self.sigma_box = rock.min_stress_at(z)
         self.kprime_box = K_PRIME_FACTOR * rock.toughness_at(z)
@@ -231,11 +244,30 @@ class _Engine:
         dense = use_dense(self.num.linear_solver, self.num.krylov_threshold, self.ix, self.iz,
                           stationary=not self.pumping)
         self.elastic = Elasticity(self.op, self.ix, self.iz, dense)
-        self.faces = build_faces(self.ix, self.iz, self.dx, self.dz, self.mu_prime)
+        self.slurry_faces()
         sel = (self.rows, self.cols)
         self.sigma_a, self.cprime_a = self.sigma_box[sel], self.cprime_box[sel]
         self.inj = int(np.flatnonzero((self.ix == 0) & (self.iz == 0))[0])
         self.distances = None
+
+    def slurry_faces(self) -> None:
+        """The lubrication faces of the active set with the slurry's viscosity ratio (slurry.py), and the tip
+        asymptote's mu' times the mean ratio of the edge cells the slurry does not block (1 without any)."""
+        if self.ratio_box is None:
+            self.faces = build_faces(self.ix, self.iz, self.dx, self.dz, self.mu_prime)
+            return
+        ratio = self.ratio_box[self.rows, self.cols]
+        self.faces = build_faces(self.ix, self.iz, self.dx, self.dz, self.mu_prime, ratio)
+        moving = edge_cells(self.grid["active"]) & ~self.blocked_box
+        tip_ratio = float(self.ratio_box[moving].mean()) if moving.any() else 1.0
+        self.tip = dataclasses.replace(self.tip, mu_prime=self.mu_prime * tip_ratio)
+
+    def use_slurry(self, slurry: Slurry) -> None:
+        """Continue with the slurry's fields (two-way coupling, hfgpu.coupled): viscosity ratios, blocked
+        cells, the width floor after shut-in."""
+        self.slurry = slurry
+        self.load_properties()
+        self.slurry_faces()
 
     def use_grid(self, grid: Grid) -> None:
         """Continue on ``grid`` (a grown box, or the step's start grid again for a retry)."""
@@ -271,10 +303,15 @@ class _Engine:
         closed = g.shut(self.t)[sel] if pinned is None else None   # the last step's contact set
         if closed is not None and source[self.inj] > 0.0:
             closed[self.inj] = False   # the injected fluid opens the perforated cell of a closed fracture
+        contact = None   # without injection, the walls meet on the proppant (slurry.py's floor; never above w_old)
+        if self.floor_box is not None and closed is not None and not source.any():
+            contact = np.minimum(self.floor_box[sel], np.maximum(w_old, 0.0))
+            closed |= (contact > 0.0) & (w_old <= contact)
         if closed is not None and closed.all() and not source.any():   # a closed fracture: nothing moves
             zero = np.zeros(w_old.size)
-            return StepResult(w=zero, p=g["p"][sel].copy(), leaked=zero, demand=zero, iterations=0, converged=True,
-                              residual=zero, work=NewtonWork())
+            return StepResult(w=zero if contact is None else contact.copy(), p=g["p"][sel].copy(), leaked=zero,
+                              demand=zero, iterations=0, converged=True, residual=zero, work=NewtonWork(),
+                              contact=contact)
         if self.num.leakoff_clock:   # with a wetted fraction: the volume leaked per wetted area
             clock = leaked_old if wetted is None else np.divide(leaked_old, wetted, out=np.zeros_like(leaked_old),
                                                                 where=wetted > 0.0)
@@ -283,7 +320,7 @@ class _Engine:
             demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt, filled)
         w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
         prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
-                           demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted, self.closure_width)
+                           demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted, self.closure_width, contact)
         if w_start is not None:
             first = np.where(w_start > 0.0, w_start, start_widths(prob))
         else:
@@ -322,16 +359,18 @@ class _Engine:
         self.t += dt
         self.w_peak = max(self.w_peak, float(res.w.max()))
         shut_in = self.schedule.mean_rate(t_a, self.t) <= 0.0
-        drained = shut_in & (res.w > 0.0) & (res.w < self.closure_width) \
-            & (res.demand >= res.w * self.area) & (g["opened"][sel] < t_a)   # one step to fill a new cell
+        base = 0.0 if res.contact is None else res.contact   # the walls close on the proppant (slurry.py)
+        film = res.w - base
+        drained = shut_in & (film > 0.0) & (film < self.closure_width) \
+            & (res.demand >= film * self.area) & (g["opened"][sel] < t_a)   # one step to fill a new cell
         if pinned is not None:
             drained &= ~pinned
             if drained.any():
                 self.recede()
         w_start = g["w"][sel]
-        emptied = drained | (shut_in & (res.w < 0.0))   # and a width the contact passes left below 0
-        w = np.where(emptied, 0.0, res.w)
-        leaked = res.leaked + np.where(emptied, res.w * self.area, 0.0)   # the film leaks off as the walls meet
+        emptied = drained | (shut_in & (film < 0.0))   # and a width the contact passes left below 0
+        w = np.where(emptied, base, res.w)
+        leaked = res.leaked + np.where(emptied, film * self.area, 0.0)   # the film leaks off as the walls meet
         g["w"][sel] = w
         g["p"][sel] = res.p
         self.distances = None
@@ -454,8 +493,79 @@ def _landed(output: float, t: float) -> bool:
     return abs(output - t) <= 1e-9 * t
 
 
+class FractureRun:
+    """One run of the engine driven to a time: ``advance(until)`` steps it there (landing a step on it), so a
+    caller can hand it a slurry between calls (``engine.use_slurry``, the two-way coupled loop of
+    hfgpu.coupled); :func:`simulate` advances it to the end at once. Arguments as :func:`simulate`'s, plus the
+    ``slurry`` it starts in (fracture/slurry.py; None: clean fluid)."""
+
+    def __init__(self, scene, sink, progress: Callable[[float], None] | None = None, checkpoint=None,
+                 resume: dict | None = None, slurry: Slurry | None = None):
+        check_scene(scene)
+        numerics = scene.fracture if scene.fracture is not None else FractureNumerics()
+        self.sink, self.progress, self.checkpoint = sink, progress, checkpoint
+        self.engine = eng = _Engine(scene, numerics, slurry)
+        self.targets, self.outputs = _times(scene, eng.t0)
+        self.dt = numerics.time_step_relaxation * min(eng.dx, eng.dz) / eng.v_front
+        self.index = 0   # the step target being approached
+        if resume is not None:
+            eng.restore(resume["engine"])
+            self.dt, self.index = resume["dt"], int(resume["target"])
+        self.k = sum(1 for t in self.outputs if t < eng.t or _landed(t, eng.t)) if resume is not None else 0
+
+    def advance(self, until: float) -> None:
+        """Step to ``until`` (or the end), writing records and snapshots (:func:`simulate`)."""
+        eng, targets, outputs, sink, progress = self.engine, self.targets, self.outputs, self.sink, self.progress
+        while self.index < len(targets):
+            target = min(targets[self.index], until)
+            while eng.t < target * (1 - 1e-12):
+                remaining = target - eng.t
+                step = min(self.dt, remaining)
+                if remaining - step < 1e-3 * step:
+                    step = remaining
+                if step < MIN_STEP_FRACTION * eng.t:   # of the time reached, not of the next target (a long shut-in)
+                    raise SimulationError(f"the time step fell to {step:.3g} s (below {MIN_STEP_FRACTION:g} of the "
+                                          "time): the front keeps moving more than max_front_advance cells however "
+                                          "short the step; raise [fracture] max_front_advance", time=eng.t)
+                taken = eng.step(step, keep_ends=self.k < len(outputs) and outputs[self.k] < eng.t + step)
+                if abs(eng.t - target) < 1e-9 * target:
+                    eng.t = target
+                record = eng.balance()
+                error = abs(record.injected - record.stored - record.leaked) / record.injected
+                eng.max_balance_error = max(eng.max_balance_error, error)
+                sink.fracture_balance(record)
+                if progress is not None:
+                    progress(eng.t)
+                    show_limit(progress, taken, "snapshot interval" if taken == step == remaining else "front advance")
+                while self.k < len(outputs) and (outputs[self.k] < eng.t or _landed(outputs[self.k], eng.t)):
+                    view = eng.now() if _landed(outputs[self.k], eng.t) else eng.between(outputs[self.k])
+                    sink.fracture_snapshot(snapshot(eng, view, outputs[self.k]))
+                    self.k += 1
+                if eng.t < targets[-1]:   # a merge is for the steps that follow
+                    eng.coarsen_if_wide()
+                self.dt = eng.next_dt(self.dt if taken == step else taken)
+                if self.checkpoint is not None and self.checkpoint.due(eng.t):
+                    self.checkpoint.save(eng.t, {"engine": eng.state(), "dt": self.dt, "target": self.index})
+            if target < targets[self.index]:
+                return
+            self.index += 1
+
+    def summary(self) -> dict:
+        """The run's summary (:func:`simulate`)."""
+        eng = self.engine
+        final = eng.balance()
+        return dict(time=eng.t, t0=eng.t0, steps=eng.steps, newton_iterations=eng.newton_iterations,
+                    factorisations=eng.factorisations, gmres_iterations=eng.gmres_iterations, retries=eng.retries,
+                    rejected=eng.rejected, coarsenings=eng.coarsenings, dx=eng.dx, dz=eng.dz,
+                    cells=int(eng.grid["active"].sum()), w_inlet=final.inlet_width,
+                    p_inlet=final.injection_pressure, injected=final.injected, stored=final.stored,
+                    leaked=final.leaked, max_balance_error=eng.max_balance_error, closed_at=eng.t_closed,
+                    **front_extents(eng, eng.now()),
+                    **geometry(eng, eng.now()))
+
+
 def simulate(scene, sink, progress: Callable[[float], None] | None = None, checkpoint=None,
-             resume: dict | None = None) -> dict:
+             resume: dict | None = None, slurry: Slurry | None = None) -> dict:
     """Run the planar-3D fracture model of ``scene`` to ``run.end_time`` (paper sections 2.2, 3.1).
 
     Calls ``sink.fracture_balance(BalanceRecord)`` after every accepted step and
@@ -474,54 +584,9 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
     Checkpoints (hfgpu.io.checkpoint): after the first step that ends at or past each interval (and after
     that step's snapshots), ``checkpoint.save(t, state)`` gets {"engine": the engine's state (engine_state.py),
     "dt": next step, "target": index of the step target}; ``resume`` (such a state) continues from it, with the
-    same steps as an uninterrupted run and the snapshots after t.
+    same steps as an uninterrupted run and the snapshots after t. ``slurry`` (fracture/slurry.py): the run in
+    that slurry throughout (None: the clean fluid).
     """
-    check_scene(scene)
-    numerics = scene.fracture if scene.fracture is not None else FractureNumerics()
-    eng = _Engine(scene, numerics)
-    targets, outputs = _times(scene, eng.t0)
-    dt = numerics.time_step_relaxation * min(eng.dx, eng.dz) / eng.v_front
-    first = 0
-    if resume is not None:
-        eng.restore(resume["engine"])
-        dt, first = resume["dt"], int(resume["target"])
-    k = sum(1 for t in outputs if t < eng.t or _landed(t, eng.t)) if resume is not None else 0   # next output
-    for index in range(first, len(targets)):
-        target = targets[index]
-        while eng.t < target * (1 - 1e-12):
-            remaining = target - eng.t
-            step = min(dt, remaining)
-            if remaining - step < 1e-3 * step:
-                step = remaining
-            if step < MIN_STEP_FRACTION * eng.t:   # of the time reached, not of the next target (a long shut-in)
-                raise SimulationError(f"the time step fell to {step:.3g} s (below {MIN_STEP_FRACTION:g} of the "
-                                      "time): the front keeps moving more than max_front_advance cells however "
-                                      "short the step; raise [fracture] max_front_advance", time=eng.t)
-            taken = eng.step(step, keep_ends=k < len(outputs) and outputs[k] < eng.t + step)
-            if abs(eng.t - target) < 1e-9 * target:
-                eng.t = target
-            record = eng.balance()
-            error = abs(record.injected - record.stored - record.leaked) / record.injected
-            eng.max_balance_error = max(eng.max_balance_error, error)
-            sink.fracture_balance(record)
-            if progress is not None:
-                progress(eng.t)
-                show_limit(progress, taken, "snapshot interval" if taken == step == remaining else "front advance")
-            while k < len(outputs) and (outputs[k] < eng.t or _landed(outputs[k], eng.t)):
-                view = eng.now() if _landed(outputs[k], eng.t) else eng.between(outputs[k])
-                sink.fracture_snapshot(snapshot(eng, view, outputs[k]))
-                k += 1
-            if eng.t < targets[-1]:   # a merge is for the steps that follow
-                eng.coarsen_if_wide()
-            dt = eng.next_dt(dt if taken == step else taken)
-            if checkpoint is not None and checkpoint.due(eng.t):
-                checkpoint.save(eng.t, {"engine": eng.state(), "dt": dt, "target": index})
-    final = eng.balance()
-    return dict(time=eng.t, t0=eng.t0, steps=eng.steps, newton_iterations=eng.newton_iterations,
-                factorisations=eng.factorisations, gmres_iterations=eng.gmres_iterations, retries=eng.retries,
-                rejected=eng.rejected, coarsenings=eng.coarsenings, dx=eng.dx, dz=eng.dz,
-                cells=int(eng.grid["active"].sum()), w_inlet=final.inlet_width,
-                p_inlet=final.injection_pressure, injected=final.injected, stored=final.stored,
-                leaked=final.leaked, max_balance_error=eng.max_balance_error, closed_at=eng.t_closed,
-                **front_extents(eng, eng.now()),
-                **geometry(eng, eng.now()))
+    run = FractureRun(scene, sink, progress, checkpoint, resume, slurry)
+    run.advance(scene.run.end_time)
+    return run.summary()

@@ -231,6 +231,12 @@ def summary_rows(summary: dict[str, Any], system: str = "SI", density: float | N
             held += f" ({format_number(100.0 * screened / pumped, 3)} % of pumped)"
         add("proppant", "held back at the inlet", held)
         add("proppant", "screen-out began", _when(_first(s, "proppant_screen_out_time", "screen_out_time"), system))
+    if "tip_screen_out_time" in s:   # a two-way coupled run (hfgpu.coupled.simulate_two_way)
+        tso = s["tip_screen_out_time"]
+        add("proppant", "tip screen-out", _when(tso, system))
+        if _finite(tso):
+            add("proppant", "net pressure rise after it", _quantity(s.get("net_pressure_rise"), "pressure", system))
+        add("proppant", "packed length", _quantity(s.get("packed_length"), "length", system))
     outflow = s.get("proppant_outflow")
     if _finite(outflow) and outflow > 0:
         add("proppant", "left the domain", _proppant_amount(outflow, density, system))

@@ -85,7 +85,7 @@ class Watch:
                          f"theta_p {theta[k, i]:.3g} in the cell at {self._where(frame, k, i)}, "
                          f"{self._width(width[k, i])} wide, below the smallest grain "
                          f"({self._width(self.smallest_grain)}); the cell is closing around its proppant, "
-                         "which the one-way coupled fracture does not feel")
+                         "which a one-way coupled fracture does not feel ([coupling] mode = \"two-way\" does)")
 
     def check_step(self, t: float, dt: float, nominal: float, limits: dict[str, float], frame, fast_cell,
                    width: np.ndarray, theta: np.ndarray) -> None:

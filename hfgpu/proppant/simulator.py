@@ -193,6 +193,8 @@ class ProppantSimulation:
         self.limited_by = "dt_max"
         self.watch = Watch(self.params.theta_cp, min(c.size.d_min for c in setup.classes), scene.output.units)
         self.fluid_totals = dict.fromkeys(FLUID_VOLUMES, 0.0)
+        self.next_out = 0.0       # the next snapshot's time (run, advance)
+        self.max_residual = 0.0   # the largest continuity residual of the steps so far
 
     # -- set-up ---------------------------------------------------------------------------------------
 
@@ -382,27 +384,32 @@ class ProppantSimulation:
         Checkpoints (hfgpu.io.checkpoint): after the first step that ends at or past each interval,
         ``checkpoint.save(time, state)`` gets {"simulation": :meth:`state`, "next_out", "max_residual"};
         ``resume`` (such a state) continues from it, with the same steps as an uninterrupted run."""
+        if resume is not None:
+            self.restore(resume["simulation"])
+            self.next_out, self.max_residual = resume["next_out"], resume["max_residual"]
+        self.advance(self.scene.run.end_time, sink, progress, on_step, checkpoint)
+        return self.finish(sink)
+
+    def advance(self, until: float, sink: ProppantSink, progress: Callable[[float], None] | None = None,
+                on_step: Callable[[StepInfo], None] | None = None, checkpoint=None) -> None:
+        """Step to ``until`` (a step lands on it), writing the snapshots due and a balance record every step
+        (:meth:`run`; the two-way coupled loop of hfgpu.coupled calls it interval by interval)."""
         end = self.scene.run.end_time
         every = self.scene.output.every
         breaks = sorted(b for b in (self.scene.injection.schedule.breakpoints()
                                     if self.scene.injection is not None else ()) if 0.0 < b < end)
-        next_out = 0.0
         eps = 1e-9 * end
-        max_residual = 0.0
-        if resume is not None:
-            self.restore(resume["simulation"])
-            next_out, max_residual = resume["next_out"], resume["max_residual"]
         while True:
-            if self.time >= next_out - eps:
+            if self.time >= self.next_out - eps:
                 sink.proppant_snapshot(self.snapshot())
-                next_out += every
-            if self.time >= end - eps:
+                self.next_out += every
+            if self.time >= until - eps:
                 break
-            targets = [end, next_out] + [b for b in breaks if b > self.time + eps]
+            targets = [until, self.next_out] + [b for b in breaks if b > self.time + eps]
             if self.steps == 0 and self.engine.name == "taichi":
                 note(progress, "compiling kernels")
             info = self.step(limit=min(targets) - self.time)
-            max_residual = max(max_residual, info.continuity_residual)
+            self.max_residual = max(self.max_residual, info.continuity_residual)
             sink.proppant_balance(self.balance())
             if on_step is not None:
                 on_step(info)
@@ -410,15 +417,18 @@ class ProppantSimulation:
                 progress(self.time)
                 show_limit(progress, info.dt, self.limited_by)
             if checkpoint is not None and checkpoint.due(self.time):
-                checkpoint.save(self.time, {"simulation": self.state(), "next_out": next_out,
-                                            "max_residual": max_residual})
-        if abs(self.time - (next_out - every)) > eps:
+                checkpoint.save(self.time, {"simulation": self.state(), "next_out": self.next_out,
+                                            "max_residual": self.max_residual})
+
+    def finish(self, sink: ProppantSink) -> dict:
+        """The last snapshot (unless one was just written) and the run's summary (:meth:`run`)."""
+        if abs(self.time - (self.next_out - self.scene.output.every)) > 1e-9 * self.scene.run.end_time:
             sink.proppant_snapshot(self.snapshot())
         record = self.balance()
         return dict(time=self.time, steps=self.steps, parcels=self.engine.live, injected=record.injected,
                     in_domain=record.in_domain, outflow=record.outflow, screened_out=record.screened_out,
                     screen_out_time=self.screen_out_time,
-                    max_continuity_residual=max_residual, backend=self.engine.name, arch=self.engine.arch,
+                    max_continuity_residual=self.max_residual, backend=self.engine.name, arch=self.engine.arch,
                     threads=self.engine.threads or 0, **self.watch.summary(),
                     **{f"fluid_{name}": value for name, value in self.fluid_totals.items()})
 

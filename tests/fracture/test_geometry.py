@@ -96,3 +96,16 @@ def test_a_run_reports_its_footprint_in_the_summary_and_every_snapshot(front):
         assert out["area_radius"] == pytest.approx(out["radius"], rel=0.02)
     areas = [float(s.extras["area"]) for s in sink.fracture_snapshots]
     assert areas == sorted(areas)
+
+
+def test_a_strip_one_cell_across_has_a_finite_footprint():
+    """Closed cells above and below a row (a fracture closed onto a one-row pack): the front runs at +-s about
+    each cell's centre, f = 2 s / h across the strip (the normals of the two sides cancel)."""
+    active = np.zeros((5, 5), bool)
+    active[2, :] = True
+    distances = [np.full((5, 5), np.nan) for _ in range(4)]   # +x, -x, +z, -z (front.DIRECTIONS)
+    for side in (2, 3):
+        distances[side][2, :] = 0.3
+    f = filled_fraction("cells", active, np.zeros((5, 5)), distances, 1.0, 1.0)
+    np.testing.assert_allclose(f[2], 0.6)
+    assert np.all(f[[0, 1, 3, 4]] == 0.0)
