@@ -13,6 +13,18 @@ SIMULATORS = {("fracture",): "hfgpu.fracture.simulator", ("proppant",): "hfgpu.p
               ("fracture", "proppant"): "hfgpu.coupled"}
 
 
+#: The module that runs a fracture scene whose ``[completion]`` has several clusters (the stage of N planes).
+STAGE_SIMULATOR = "hfgpu.fracture.stage"
+
+
+def simulator_module(scene: Any) -> str:
+    """The module of :data:`SIMULATORS` that runs ``scene``; :data:`STAGE_SIMULATOR` for several clusters."""
+    completion = getattr(scene, "completion", None)
+    if completion is not None and completion.clusters > 1:
+        return STAGE_SIMULATOR
+    return SIMULATORS[tuple(scene.run.physics)]
+
+
 class NotSupportedError(HfgpuError, NotImplementedError):
     """The scene asks for something this version does not run yet."""
 

@@ -1,0 +1,100 @@
+"""A stage of several clusters (hfgpu.fracture.stage): one cluster is the single fracture, far-apart identical
+clusters split the rate equally, the wellbore node holds at every step, the shadow of a tight uniform array
+suppresses its inner fractures (Peirce & Bunger 2015, SPE J 20(2)) and entry friction well above the shadow evens
+them out."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hfgpu.fracture import simulator, stage
+from hfgpu.perforations import entry_coefficient
+from hfgpu.records import MemorySink
+from hfgpu.scene import load_scene
+
+from .helpers import scene_text
+
+BASE = dict(end_time="200 s", rate="5e-3 m**3/s", cell="1.5 m")
+LIMITED = 'perforations = 2\nperforation_diameter = "0.3 in"\ndischarge_coefficient = 0.8\n'
+
+
+class StageSink(MemorySink):
+    def __init__(self):
+        super().__init__()
+        self.stage_records = []
+
+    def stage_record(self, record):
+        self.stage_records.append(record)
+
+
+def run(completion: str, **kw):
+    scene = load_scene(scene_text(**(BASE | kw)) + "[completion]\n" + completion)
+    sink = StageSink()
+    return stage.simulate(scene, sink), sink, scene
+
+
+def test_one_cluster_without_friction_is_the_single_fracture():
+    """To round-off (1e-10 relative; measured 4e-12: the cluster's injected volume is summed step by step)."""
+    single_sink = MemorySink()
+    single = simulator.simulate(load_scene(scene_text(**BASE)), single_sink)
+    staged, sink, _ = run("clusters = 1\n")
+    assert staged["steps"] == single["steps"] and staged["stage_iterations"] == single["steps"]
+    for key in ("area", "injected", "stored", "leaked"):
+        assert staged[key] == pytest.approx(single[key], rel=1e-10)
+    (cluster,) = staged["clusters"]
+    assert cluster["p_inlet"] == pytest.approx(single["p_inlet"], rel=1e-10)
+    assert cluster["w_inlet"] == pytest.approx(single["w_inlet"], rel=1e-10)
+    assert staged["wellbore_pressure"] == pytest.approx(single["p_inlet"], rel=1e-10)
+    np.testing.assert_allclose([r.injection_pressure for r in sink.fracture_balances],
+                               [r.injection_pressure for r in single_sink.fracture_balances], rtol=1e-10)
+    np.testing.assert_allclose(sink.fracture_snapshots[-1].width, single_sink.fracture_snapshots[-1].width,
+                               rtol=1e-10, atol=1e-16)
+
+
+def test_identical_clusters_far_apart_split_the_rate_equally():
+    summary, sink, _ = run('positions = ["0 m", "1000 m", "2000 m"]\n' + LIMITED)
+    rates = np.array([c["rate"] for c in summary["clusters"]])
+    np.testing.assert_allclose(rates, rates.mean(), rtol=5e-3)
+    np.testing.assert_allclose([c["area"] for c in summary["clusters"]], summary["clusters"][0]["area"], rtol=5e-3)
+    assert rates.sum() == pytest.approx(5e-3, rel=1e-12)
+    assert summary["max_balance_error"] < 1e-12 and summary["unconverged_steps"] == 0
+
+
+def test_two_clusters_of_different_stress_meet_one_wellbore_pressure():
+    """No shadow (1 km apart), 0.5 MPa more stress on the second: it takes less, and at every step
+    p_w = p_i + a q_i^2 for both (the iteration's tolerance: rates within 1e-3 Q)."""
+    summary, sink, scene = run('positions = ["0 m", "1000 m"]\nstress_offsets = ["0 MPa", "0.5 MPa"]\n' + LIMITED)
+    a = entry_coefficient(1000.0, 2, 0.3 * 0.0254, 0.8)
+    for record in sink.stage_records:
+        q = record.rates
+        assert q.sum() == pytest.approx(5e-3, rel=1e-12) and q[1] < q[0]
+        for i in range(2):
+            p_i = record.clusters[i].injection_pressure
+            assert record.wellbore_pressure == pytest.approx(p_i + a * q[i] ** 2, rel=2e-3)
+    assert summary["unconverged_steps"] == 0
+
+
+def areas(spacing: str, extra: str = ""):
+    summary, _, _ = run(f'clusters = 5\nspacing = "{spacing}"\n' + extra)
+    return np.array([c["area"] for c in summary["clusters"]]), summary
+
+
+def test_a_tight_uniform_array_without_entry_friction_suppresses_its_inner_fractures():
+    """Peirce & Bunger (2015, SPE J 20(2), 'Interference fracturing: nonuniform distributions of perforation
+    clusters that promote simultaneous growth'): in a uniform 5-cluster array with negligible entry friction the
+    outer fractures take the fluid and the inner ones are suppressed (qualitative; their figures were not
+    digitised here). Spacing 6 m, about 0.6 of the final radius."""
+    area, summary = areas("6 m")
+    assert area[0] == pytest.approx(area[4], rel=1e-6) and area[1] == pytest.approx(area[3], rel=1e-6)
+    assert area[1] < 0.5 * area[0] and area[2] < 0.5 * area[0]
+    rates = [c["rate"] for c in summary["clusters"]]
+    assert rates[0] > 0.4 * 5e-3 / 2 and max(rates[1:4]) < 0.1 * 5e-3
+    assert summary["max_balance_error"] < 1e-12
+
+
+def test_entry_friction_well_above_the_shadow_evens_out_the_fractures():
+    """The same array with 1 perforation of 0.2 in per cluster (dp_perf about 20 MPa at Q / 5, far above the
+    shadow's few MPa): every fracture within 10 % of the mean area."""
+    area, summary = areas("6 m", 'perforations = 1\nperforation_diameter = "0.2 in"\ndischarge_coefficient = 0.8\n')
+    assert np.max(np.abs(area / area.mean() - 1.0)) < 0.10
