@@ -94,7 +94,9 @@ def test_a_tight_uniform_array_without_entry_friction_suppresses_its_inner_fract
 
 
 def test_entry_friction_well_above_the_shadow_evens_out_the_fractures():
-    """The same array with 1 perforation of 0.2 in per cluster (dp_perf about 20 MPa at Q / 5, far above the
-    shadow's few MPa): every fracture within 10 % of the mean area."""
-    area, summary = areas("6 m", 'perforations = 1\nperforation_diameter = "0.2 in"\ndischarge_coefficient = 0.8\n')
+    """The same array with 1 perforation of 0.15 in per cluster: dp_perf 5.3 to 6.8 MPa, well above the shadow
+    (the inner inlet's pressure over sigma_0 exceeds the outer's by 1.5 MPa): every fracture within 10 % of the
+    mean area (measured: 0.12 %)."""
+    area, summary = areas("6 m", 'perforations = 1\nperforation_diameter = "0.15 in"\ndischarge_coefficient = 0.8\n')
     assert np.max(np.abs(area / area.mean() - 1.0)) < 0.10
+    assert summary["unconverged_steps"] == 0
