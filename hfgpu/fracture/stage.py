@@ -15,9 +15,10 @@ The coupled step is a Jacobi iteration inside each time step. From the planes' s
 [t, t + dt] with its rate q_i^k and the shadow of the other planes' widths of the last iterate (their widths at t
 on the first); its inlet pressure p_i^k gives the linearisation p_i(q) = p_i^k + s_i (q - q_i^k), s_i the secant
 of the last two iterates (else the previous step's; at the first step (p_i - sigma_i) / (3 q_i), the viscosity
-vertex's p_net ~ q^(1/3)), and the node gives q^(k+1). The iteration stops when the rates change by less than
-STAGE_TOLERANCE Q and the shadow the new widths cast differs from the one the step used by less than
-STAGE_TOLERANCE of each plane's net pressure at its inlet: iterate k is kept. It is not one block Newton because
+vertex's p_net ~ q^(1/3)), and the node gives q^(k+1). The iteration stops when the wellbore pressures the
+clusters taking fluid ask for, p_i^k + a_i (q_i^k)^2, agree within STAGE_TOLERANCE of their mean net pressure and
+the shadow the new widths cast differs from the one the step used by less than STAGE_TOLERANCE of each plane's net
+pressure at its inlet: iterate k is kept, p_w the mean of those pressures. It is not one block Newton because
 each plane's step keeps its own front, retries and contact set (front_strategy.py): the engines run unchanged
 behind one hook (_Engine.stress_shift); the shadow is a smooth far-field load, and the measured iterations per
 step are in the summary (``stage_iterations``, ``unconverged_steps``) and docs/validation.md.
@@ -98,7 +99,8 @@ class StageEngine:
         self.offsets = completion.offsets()
         self.operator = PlanesOperator(first.dx, first.dz, first.e_prime, completion.positions)
         self.sources = [self._widths(plane) for plane in self.planes]
-        self.rates = np.full(n, self.pump.rate(self.t0) / n)
+        self.rates = np.full(n, self.pump.rate(self.t0) / n)   # the last pumping step's split
+        self.step_rates = self.rates.copy()                      # the rates over the last step
         self.slopes: np.ndarray | None = None
         self.p_wellbore = math.nan
         self.iterations = self.unconverged = self.steps = 0
@@ -157,7 +159,9 @@ class StageEngine:
                 self.unconverged += not done
                 break
             rates = new_rates
-        self.rates = rates
+        self.step_rates = rates
+        if q_total > 0.0:   # the split a later pumping step starts from
+            self.rates = rates
         for inlet in self.inlets:
             inlet.commit(self.t + dt)
         self.t += dt
@@ -177,8 +181,12 @@ class StageEngine:
             return rates, change <= STAGE_TOLERANCE
         slopes = self._slopes(rates, pressures, net, q_total, before)
         entries = [Entry(float(p), float(s), float(q)) for p, s, q in zip(pressures, slopes, rates)]
-        new_rates, self.p_wellbore = split_rate(q_total, entries, self.coefficients)
-        done = float(np.max(np.abs(new_rates - rates))) <= STAGE_TOLERANCE * q_total and change <= STAGE_TOLERANCE
+        new_rates, _ = split_rate(q_total, entries, self.coefficients)
+        heads = pressures + self.coefficients * rates**2   # the wellbore pressure each cluster asks for
+        taking = rates > 0.0
+        self.p_wellbore = float(heads[taking].mean())
+        spread = float(np.max(np.abs(heads[taking] - self.p_wellbore)))
+        done = spread <= STAGE_TOLERANCE * float(np.mean(net)) and change <= STAGE_TOLERANCE
         return new_rates, done
 
     def _slopes(self, rates, pressures, net, q_total, before) -> np.ndarray:
@@ -198,15 +206,16 @@ class StageEngine:
 
     def record(self) -> StageRecord:
         """The stage at the current time: each cluster's balance record, rate and the wellbore pressure."""
-        return StageRecord(time=self.t, wellbore_pressure=self.p_wellbore, rates=self.rates.copy(),
+        return StageRecord(time=self.t, wellbore_pressure=self.p_wellbore, rates=self.step_rates.copy(),
                            clusters=tuple(plane.balance() for plane in self.planes))
 
 
 def stage_balance(record: StageRecord) -> BalanceRecord:
     """The stage's balance as one fracture's: volumes and areas summed, the wellbore pressure as the injection
-    pressure, the net pressure, inlet width, length and height those of the cluster taking the most fluid."""
+    pressure (while the pumps stop, when no wellbore pressure joins the clusters: the inlet pressure of the cluster
+    that has taken the most fluid), the net pressure, inlet width, length and height those of that cluster."""
     c = record.clusters
-    lead = c[int(np.argmax(record.rates))]
+    lead = c[int(np.argmax([r.injected for r in c]))]
     injected, stored = sum(r.injected for r in c), sum(r.stored for r in c)
     pressure = record.wellbore_pressure if math.isfinite(record.wellbore_pressure) else lead.injection_pressure
     return BalanceRecord(time=record.time, injected=injected, stored=stored, leaked=sum(r.leaked for r in c),
@@ -267,20 +276,25 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
     return summary(stage)
 
 
+#: The per-cluster values the summary also gives as scalars ``cluster_<i>_<key>`` (the results file's /summary).
+CLUSTER_SUMMARY = ("rate", "injected", "stored", "p_inlet", "area", "length", "height")
+
+
 def summary(stage: StageEngine) -> dict:
-    """The stage's summary (:func:`simulate`)."""
+    """The stage's summary (:func:`simulate`), with each cluster's CLUSTER_SUMMARY values as scalars."""
     record = stage.record()
     total = stage_balance(record)
     clusters = []
     for i, plane in enumerate(stage.planes):
         r = record.clusters[i]
-        clusters.append(dict(injected=r.injected, stored=r.stored, leaked=r.leaked, rate=float(stage.rates[i]),
+        clusters.append(dict(injected=r.injected, stored=r.stored, leaked=r.leaked, rate=float(stage.step_rates[i]),
                              p_inlet=r.injection_pressure, w_inlet=r.inlet_width,
                              max_balance_error=float(stage.max_balance_error[i]), cells=int(plane.grid["active"].sum()),
                              steps=plane.steps, newton_iterations=plane.newton_iterations,
                              **front_extents(plane, plane.now()), **geometry(plane, plane.now())))
+    flat = {f"cluster_{i}_{key}": c[key] for i, c in enumerate(clusters) for key in CLUSTER_SUMMARY}
     return dict(time=stage.t, t0=stage.t0, steps=stage.steps, stage_iterations=stage.iterations,
                 unconverged_steps=stage.unconverged, dx=stage.planes[0].dx, dz=stage.planes[0].dz,
                 injected=total.injected, stored=total.stored, leaked=total.leaked, area=total.area,
                 wellbore_pressure=record.wellbore_pressure,
-                max_balance_error=float(stage.max_balance_error.max()), clusters=clusters)
+                max_balance_error=float(stage.max_balance_error.max()), clusters=clusters, **flat)

@@ -63,7 +63,8 @@ def test_identical_clusters_far_apart_split_the_rate_equally():
 
 def test_two_clusters_of_different_stress_meet_one_wellbore_pressure():
     """No shadow (1 km apart), 0.5 MPa more stress on the second: it takes less, and at every step
-    p_w = p_i + a q_i^2 for both (the iteration's tolerance: rates within 1e-3 Q)."""
+    p_w = p_i + a q_i^2 for both (the iteration's tolerance: within 1e-3 of the net pressure; measured 1.3e-4 of
+    p_w)."""
     summary, sink, scene = run('positions = ["0 m", "1000 m"]\nstress_offsets = ["0 MPa", "0.5 MPa"]\n' + LIMITED)
     a = entry_coefficient(1000.0, 2, 0.3 * 0.0254, 0.8)
     for record in sink.stage_records:
@@ -96,7 +97,32 @@ def test_a_tight_uniform_array_without_entry_friction_suppresses_its_inner_fract
 def test_entry_friction_well_above_the_shadow_evens_out_the_fractures():
     """The same array with 1 perforation of 0.15 in per cluster: dp_perf 5.3 to 6.8 MPa, well above the shadow
     (the inner inlet's pressure over sigma_0 exceeds the outer's by 1.5 MPa): every fracture within 10 % of the
-    mean area (measured: 0.12 %)."""
+    mean area (measured: 0.07 %)."""
     area, summary = areas("6 m", 'perforations = 1\nperforation_diameter = "0.15 in"\ndischarge_coefficient = 0.8\n')
     assert np.max(np.abs(area / area.mean() - 1.0)) < 0.10
     assert summary["unconverged_steps"] == 0
+
+
+def test_the_results_file_holds_each_clusters_history(tmp_path):
+    """``hfgpu run`` of a 3-cluster stage with a shut-in: /stage/balance rows sum to the pump rate, p_w is each
+    pumping cluster's inlet pressure plus its perforation friction, the fracture balance carries p_w and the
+    per-cluster summary scalars."""
+    from hfgpu.io.results import open_results
+    from hfgpu.runner import run as hfgpu_run
+
+    text = scene_text(**(BASE | dict(schedule='[{ until = "150 s", rate = "5e-3 m**3/s" }, '
+                                              '{ until = "200 s", rate = "0 m**3/s" }]', every="100 s")))
+    text += '[completion]\nclusters = 3\nspacing = "6 m"\n' + LIMITED
+    hfgpu_run(load_scene(text), tmp_path / "stage.h5", progress=False)
+    r = open_results(tmp_path / "stage.h5")
+    b, f = r.stage_balance, r.fracture_balance
+    assert r.status == "complete" and b["rate"].shape == (b["time"].size, 3)
+    pumping = b["time"] <= 150.0
+    np.testing.assert_allclose(b["rate"][pumping].sum(axis=1), 5e-3, rtol=1e-12)
+    assert np.all(b["rate"][~pumping] == 0.0) and np.all(np.isnan(b["wellbore_pressure"][~pumping]))
+    a = entry_coefficient(1000.0, 2, 0.3 * 0.0254, 0.8)
+    heads = b["injection_pressure"][pumping] + a * b["rate"][pumping] ** 2
+    np.testing.assert_allclose(heads, np.repeat(b["wellbore_pressure"][pumping][:, None], 3, axis=1), rtol=2e-3)
+    np.testing.assert_allclose(f["injection_pressure"][pumping], b["wellbore_pressure"][pumping], rtol=1e-15)
+    np.testing.assert_allclose(f["stored"], b["stored"].sum(axis=1), rtol=1e-12)
+    assert r.summary["cluster_1_area"] == pytest.approx(b["area"][-1, 1], rel=1e-12)
