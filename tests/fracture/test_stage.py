@@ -126,3 +126,13 @@ def test_the_results_file_holds_each_clusters_history(tmp_path):
     np.testing.assert_allclose(f["injection_pressure"][pumping], b["wellbore_pressure"][pumping], rtol=1e-15)
     np.testing.assert_allclose(f["stored"], b["stored"].sum(axis=1), rtol=1e-12)
     assert r.summary["cluster_1_area"] == pytest.approx(b["area"][-1, 1], rel=1e-12)
+
+
+def test_hfgpu_plot_draws_the_split(tmp_path):
+    from hfgpu.io.plots import plot_results
+    from hfgpu.runner import run as hfgpu_run
+
+    text = scene_text(**(BASE | dict(end_time="80 s", every="80 s"))) + '[completion]\nclusters = 2\nspacing = "6 m"\n'
+    hfgpu_run(load_scene(text), tmp_path / "stage.h5", progress=False)
+    written = {p.name for p in plot_results(tmp_path / "stage.h5", tmp_path / "figures")}
+    assert {"stage_split.png", "pressure_history.png"} <= written
