@@ -136,3 +136,14 @@ def test_hfgpu_plot_draws_the_split(tmp_path):
     hfgpu_run(load_scene(text), tmp_path / "stage.h5", progress=False)
     written = {p.name for p in plot_results(tmp_path / "stage.h5", tmp_path / "figures")}
     assert {"stage_split.png", "pressure_history.png"} <= written
+
+
+def test_the_summary_table_has_a_row_per_cluster():
+    from hfgpu.io.summary import cluster_rows
+
+    summary, _, _ = run('clusters = 3\nspacing = "6 m"\n' + LIMITED)
+    rows = cluster_rows(summary, "SI")
+    shares = [float(text.split(" %")[0]) for _, _, text in rows]
+    assert [label for _, label, _ in rows] == ["cluster 1", "cluster 2", "cluster 3"]
+    assert sum(shares) == pytest.approx(100.0, abs=0.2) and shares[0] == shares[2] > shares[1]
+    assert cluster_rows({"cluster_0_area": 1.0}, "SI") == []
