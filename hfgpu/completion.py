@@ -10,7 +10,8 @@ the rock's minimum stress on that cluster's plane (the perforation friction: hfg
 Refused before any work (one-line SceneError naming the key and the value): a count, a diameter or a spacing of 0,
 C_d outside (0, 1], two clusters at one position, a list of the wrong length, clusters at a depth outside the span
 of ``[[rock.layers]]``. Warned about: clusters closer than two cells (the larger of dx, dz in use) of the shared
-fracture grid, where the shadow kernel between them is the near field of elements larger than their distance.
+fracture grid, where the shadow kernel between them is the near field of elements larger than their distance
+(tests/fracture/test_shadow.py measures its error on a penny crack's axis against the distance in cells).
 """
 
 from __future__ import annotations
@@ -158,5 +159,6 @@ def _close_spacing(t: Table, positions: tuple[float, ...], cell: float) -> None:
         system = scene_system()
         warn(f"{t.path}: clusters {display_text(gap, 'length', system)} apart are closer than "
              f"{MIN_SPACING_CELLS:g} cells of the fracture grid ({display_text(cell, 'length', system)} in use): the "
-             "stress shadow between them is the near field of elements larger than their distance, which it "
-             "misplaces by up to a cell (smaller cells resolve it)")
+             "stress shadow between them is the near field of elements larger than their distance (on a penny "
+             "crack's axis its error grows from under 0.01 % at 2 cells to 0.25 % at 1 cell and 3 % at a quarter "
+             "cell, more near the fronts); use cells at most half the spacing")
