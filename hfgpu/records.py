@@ -91,6 +91,15 @@ class StageRecord:
 
 
 @dataclass(frozen=True)
+class StageSnapshot:
+    """One cluster's fracture snapshot in a stage of several clusters: ``cluster`` its index in the order of
+    ``[completion] positions``."""
+
+    cluster: int
+    snapshot: FractureSnapshot
+
+
+@dataclass(frozen=True)
 class ProppantSnapshot:
     """Parcels and grid fields of the MP-PIC model at one time.
 

@@ -39,7 +39,7 @@ from typing import Callable
 import numpy as np
 
 from ..perforations import Entry, split_rate
-from ..records import BalanceRecord, StageRecord
+from ..records import BalanceRecord, StageRecord, StageSnapshot
 from .config import FractureNumerics
 from .shadow import PlanesOperator
 from .simulator import _Engine, _landed, _times, MIN_STEP_FRACTION, check_scene
@@ -229,8 +229,9 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
              resume: dict | None = None) -> dict:
     """Run the stage of ``scene`` (module docstring) to ``run.end_time`` as simulator.simulate runs one fracture:
     ``sink.fracture_balance`` gets the stage's balance (:func:`stage_balance`) after every step,
-    ``sink.stage_record`` (where the sink has it) each step's :class:`hfgpu.records.StageRecord`, and
-    ``sink.fracture_snapshot`` the snapshots of the first cluster. Returns simulator.simulate's summary of the
+    ``sink.stage_record`` (where the sink has it) each step's :class:`hfgpu.records.StageRecord`,
+    ``sink.fracture_snapshot`` the snapshots of the first cluster and ``sink.stage_snapshot`` (where the sink has
+    it) every cluster's (:class:`hfgpu.records.StageSnapshot`). Returns simulator.simulate's summary of the
     stage (summed volumes and area) with ``clusters`` (one summary per cluster: its volumes, footprint, rate,
     inlet pressure, front extents), ``wellbore_pressure``, ``stage_iterations`` and ``unconverged_steps``.
     ``checkpoint`` and ``resume`` are not used (a stage writes no checkpoints)."""
@@ -242,6 +243,7 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
     dt = numerics.time_step_relaxation * min(first.dx, first.dz) / first.v_front
     k = 0
     stage_record = getattr(sink, "stage_record", None)
+    stage_snapshot = getattr(sink, "stage_snapshot", None)
     for target in targets:
         while stage.t < target * (1 - 1e-12):
             remaining = target - stage.t
@@ -269,8 +271,13 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
             if progress is not None:
                 progress(stage.t)
             while k < len(outputs) and (outputs[k] < stage.t or _landed(outputs[k], stage.t)):
-                view = first.now() if _landed(outputs[k], stage.t) else first.between(outputs[k])
-                sink.fracture_snapshot(snapshot(first, view, outputs[k]))
+                for i, plane in enumerate(stage.planes):
+                    view = plane.now() if _landed(outputs[k], stage.t) else plane.between(outputs[k])
+                    snap = snapshot(plane, view, outputs[k])
+                    if i == 0:
+                        sink.fracture_snapshot(snap)
+                    if stage_snapshot is not None:
+                        stage_snapshot(StageSnapshot(i, snap))
                 k += 1
             dt = stage.next_dt(dt if taken == step else taken)
     return summary(stage)

@@ -9,6 +9,7 @@ Layout (docs/results-format.md is the full contract; extend, never rename)::
     /proppant/snapshots/000000 ...   attrs time, dx, dz, x0, z0, n_parcels; per-parcel and grid datasets
     /proppant/balance       time, injected, in_domain, outflow, screened_out (1-D, appended)
     /stage/balance          time, wellbore_pressure (1-D); rate, injection_pressure, ... (rows x clusters), a stage
+    /stage/cluster_<i>/snapshots/000000 ...   each cluster's fracture snapshots, as /fracture/snapshots
     /summary                attrs status, message, and the simulator's scalar summary values
     /closure                attrs dx, dz, x0, z0, time and the closure scalars; propped_width, conductivity, ...
     /checkpoint             attrs time and record counts; state/...: the simulator's state (removed when complete)
@@ -56,7 +57,7 @@ except ImportError:  # not POSIX
 from ..errors import HfgpuError
 from .checkpoint import read_tree, write_tree
 from ..records import (BalanceRecord, FractureSnapshot, GridFrame, ProppantSnapshot,
-                       SolidBalanceRecord, StageRecord)
+                       SolidBalanceRecord, StageRecord, StageSnapshot)
 
 FORMAT = "hfgpu-results"
 FORMAT_VERSION = 1
@@ -364,12 +365,21 @@ class ResultsWriter:
 
     def fracture_snapshot(self, snap: FractureSnapshot) -> None:
         """Write one fracture snapshot (and the buffered balance records)."""
+        self._fracture_snapshot("fracture", snap)
+
+    def stage_snapshot(self, record: StageSnapshot) -> None:
+        """Write one cluster's fracture snapshot of a stage, as ``/stage/cluster_<i>/snapshots/<k>``."""
+        group = f"stage/cluster_{record.cluster}"
+        self._counts.setdefault(group, 0)
+        self._fracture_snapshot(group, record.snapshot)
+
+    def _fracture_snapshot(self, group: str, snap: FractureSnapshot) -> None:
         fields = {name: getattr(snap, name) for name in FRACTURE_FIELDS}
         clash = set(snap.extras) & set(fields)
         if clash:
             raise HfgpuError(f"fracture snapshot extras {sorted(clash)} clash with the standard fields")
         fields.update(snap.extras)
-        self._snapshot("fracture", snap.time, snap.frame, {k: (v, "grid") for k, v in fields.items()}, {})
+        self._snapshot(group, snap.time, snap.frame, {k: (v, "grid") for k, v in fields.items()}, {})
 
     def proppant_snapshot(self, snap: ProppantSnapshot) -> None:
         """Write one proppant snapshot: per-parcel datasets (kind "parcel") and grid datasets (kind "grid")."""
@@ -653,6 +663,8 @@ class Results:
     checkpoint_time: simulated time [s] of the checkpoint the file holds (None when it holds none).
     stage_balance: ``/stage/balance`` of a stage of several clusters (1-D ``time``, ``wellbore_pressure``; the
     per-cluster columns (rows, clusters)); empty dict otherwise.
+    stage_snapshots: each cluster's fracture snapshots of a stage (``/stage/cluster_<i>/snapshots``); empty
+    otherwise.
     """
 
     path: Path
@@ -666,6 +678,7 @@ class Results:
     proppant_balance: dict[str, np.ndarray] = field(repr=False)
     checkpoint_time: float | None = None
     stage_balance: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
+    stage_snapshots: list[Snapshots] = field(default_factory=list, repr=False)
 
     @functools.cached_property
     def closure(self) -> dict[str, Any] | None:
@@ -709,7 +722,18 @@ def open_results(path: str | Path) -> Results:
             proppant_balance=_balance(f, "proppant"),
             checkpoint_time=_checkpoint_time(f),
             stage_balance=_balance(f, "stage"),
+            stage_snapshots=[_snapshots(f, path, f"stage/cluster_{i}", _fracture_snapshot)
+                             for i in range(_stage_clusters(f))],
         )
+
+
+def _stage_clusters(f: h5py.File) -> int:
+    """The clusters with snapshots under ``/stage`` (``cluster_0``, ``cluster_1``, ...)."""
+    group = f.get("stage")
+    n = 0
+    while group is not None and f"cluster_{n}" in group:
+        n += 1
+    return n
 
 
 def _checkpoint_time(f: h5py.File) -> float | None:

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from ..records import BalanceRecord, FractureSnapshot, ProppantSnapshot, SolidBalanceRecord, StageRecord
+from ..records import (BalanceRecord, FractureSnapshot, ProppantSnapshot, SolidBalanceRecord, StageRecord,
+                       StageSnapshot)
 
 
 class FractureSink(Protocol):
@@ -32,9 +33,11 @@ class ProppantSink(Protocol):
 
 class StageSink(Protocol):
     """Takes a stage's records (hfgpu.fracture.stage, several clusters): one every accepted time step, beside the
-    stage's fracture balance record."""
+    stage's fracture balance record, and each cluster's snapshot at every output time."""
 
     def stage_record(self, record: StageRecord) -> None: ...
+
+    def stage_snapshot(self, record: StageSnapshot) -> None: ...
 
 
 class ResultsSink(FractureSink, ProppantSink, Protocol):

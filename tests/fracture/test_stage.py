@@ -126,6 +126,11 @@ def test_the_results_file_holds_each_clusters_history(tmp_path):
     np.testing.assert_allclose(f["injection_pressure"][pumping], b["wellbore_pressure"][pumping], rtol=1e-15)
     np.testing.assert_allclose(f["stored"], b["stored"].sum(axis=1), rtol=1e-12)
     assert r.summary["cluster_1_area"] == pytest.approx(b["area"][-1, 1], rel=1e-12)
+    assert [len(c) for c in r.stage_snapshots] == [len(r.fracture_snapshots)] * 3
+    np.testing.assert_array_equal(r.stage_snapshots[0][-1].width, r.fracture_snapshots[-1].width)
+    last = [c[-1] for c in r.stage_snapshots]
+    np.testing.assert_allclose([float(s.extras["area"]) for s in last], b["area"][-1], rtol=1e-12)
+    assert float(last[0].extras["injected_volume"]) == pytest.approx(b["injected"][-1, 0], rel=1e-12)
 
 
 def test_hfgpu_plot_draws_the_split(tmp_path):
@@ -135,7 +140,7 @@ def test_hfgpu_plot_draws_the_split(tmp_path):
     text = scene_text(**(BASE | dict(end_time="80 s", every="80 s"))) + '[completion]\nclusters = 2\nspacing = "6 m"\n'
     hfgpu_run(load_scene(text), tmp_path / "stage.h5", progress=False)
     written = {p.name for p in plot_results(tmp_path / "stage.h5", tmp_path / "figures")}
-    assert {"stage_split.png", "pressure_history.png"} <= written
+    assert {"stage_split.png", "stage_widths.png", "pressure_history.png"} <= written
 
 
 def test_the_summary_table_has_a_row_per_cluster():
