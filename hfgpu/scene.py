@@ -446,14 +446,15 @@ def _parse(data: dict, source: str) -> Scene:
 
 def _completion(top: Table, sections: _Sections, physics: tuple[str, ...], injection: Injection | None,
                 rock: Rock | None, mesh: Mesh | None):
-    """``[completion]`` (hfgpu.completion) when the scene has it: it needs "fracture" in run.physics, [injection],
-    [rock] and [mesh]; several clusters need "fracture" alone (their proppant is not run in this version) and no
-    ``mesh.max_cells_across`` (the planes share one grid, which is not coarsened)."""
+    """``[completion]`` (hfgpu.completion) when the scene has it: it needs run.physics = ["fracture"] (the proppant
+    of a stage is not run in this version), [injection], [rock] and [mesh], and no ``mesh.max_cells_across`` with
+    several clusters (the planes share one grid, which is not coarsened)."""
     if not top.has("completion"):
         return None
-    if "fracture" not in physics:
+    if physics != ("fracture",):
         top.raw("completion")
-        sections.errors.append(SceneError("completion", "(table)", 'this section needs "fracture" in run.physics'))
+        sections.errors.append(SceneError("completion", "(table)", 'this section needs run.physics = ["fracture"] '
+                                          "(the proppant of a stage is not run in this version)"))
         return None
     if injection is None or rock is None or mesh is None:
         sections.skip("completion")
@@ -462,12 +463,7 @@ def _completion(top: Table, sections: _Sections, physics: tuple[str, ...], injec
 
     completion = sections(("completion",), lambda: parse_completion(top.table("completion"), injection.depth,
                                                                    rock.layers, max(mesh.dx, mesh.dz)))
-    if completion is None or completion.clusters == 1:
-        return completion
-    if physics != ("fracture",):
-        sections.errors.append(SceneError("run.physics", list(physics), "several [completion] clusters run with "
-                                          'physics = ["fracture"] only (their proppant is not run in this version)'))
-    if mesh.max_cells_across is not None:
+    if completion is not None and completion.clusters > 1 and mesh.max_cells_across is not None:
         sections.errors.append(SceneError("mesh.max_cells_across", mesh.max_cells_across,
                                           "not with several [completion] clusters: their planes share one grid, "
                                           "which is not coarsened; remove it"))

@@ -13,14 +13,13 @@ SIMULATORS = {("fracture",): "hfgpu.fracture.simulator", ("proppant",): "hfgpu.p
               ("fracture", "proppant"): "hfgpu.coupled"}
 
 
-#: The module that runs a fracture scene whose ``[completion]`` has several clusters (the stage of N planes).
+#: The module that runs a fracture scene with ``[completion]`` (a stage of N planes, N >= 1).
 STAGE_SIMULATOR = "hfgpu.fracture.stage"
 
 
 def simulator_module(scene: Any) -> str:
-    """The module of :data:`SIMULATORS` that runs ``scene``; :data:`STAGE_SIMULATOR` for several clusters."""
-    completion = getattr(scene, "completion", None)
-    if completion is not None and completion.clusters > 1:
+    """The module of :data:`SIMULATORS` that runs ``scene``; :data:`STAGE_SIMULATOR` with ``[completion]``."""
+    if getattr(scene, "completion", None) is not None:
         return STAGE_SIMULATOR
     return SIMULATORS[tuple(scene.run.physics)]
 
