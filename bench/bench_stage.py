@@ -52,7 +52,8 @@ def main() -> None:
         for n in cases:
             wall, summaries[n] = timed(n)
             walls[n].append(wall)
-    print(f"{'clusters':>8} {'wall [s]':>9} {'steps':>6} {'iterations':>10} {'plane steps/s':>13} {'area uniformity':>15}")
+    print(f"{'clusters':>8} {'wall [s]':>9} {'steps':>6} {'iterations':>10} {'plane steps/s':>13} "
+          f"{'area uniformity':>15}")
     for n in cases:
         s, wall = summaries[n], statistics.median(walls[n])
         areas = [c["area"] for c in s["clusters"]]

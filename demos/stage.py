@@ -34,7 +34,8 @@ def cluster_rows(path: Path) -> list[dict[str, float]]:
     total = sum(s[f"cluster_{i}_injected"] for i in range(n))
     return [dict(cluster=i + 1, fluid=convert(s[f"cluster_{i}_injected"], "m**3", "bbl"),
                  share=s[f"cluster_{i}_injected"] / total, rate=convert(s[f"cluster_{i}_rate"], "m**3/s", "bbl/min"),
-                 area=convert(s[f"cluster_{i}_area"], "m**2", "ft**2"), length=convert(s[f"cluster_{i}_length"], "m", "ft"),
+                 area=convert(s[f"cluster_{i}_area"], "m**2", "ft**2"),
+                 length=convert(s[f"cluster_{i}_length"], "m", "ft"),
                  height=convert(s[f"cluster_{i}_height"], "m", "ft"),
                  p_inlet=convert(s[f"cluster_{i}_p_inlet"], "Pa", "psi")) for i in range(n)]
 

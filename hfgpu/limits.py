@@ -69,8 +69,8 @@ def check_engine_start(scene) -> None:
 
 def _start_check(scene, engine) -> None:
     """The starting radial fracture (``fracture.initial_radius_cells`` x the larger cell in use) must form, at the
-    schedule's rates (divided among the clusters of a stage), within half the schedule and while a stage injects (as :func:`hfgpu.fracture.simulator.simulate`
-    requires)."""
+    schedule's rates (divided among the clusters of a stage), within half the schedule and while a stage injects
+    (as :func:`hfgpu.fracture.simulator.simulate` requires)."""
     import math
 
     K_PRIME_FACTOR, start_time = engine.K_PRIME_FACTOR, engine.start_time

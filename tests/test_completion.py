@@ -83,7 +83,8 @@ def test_a_cluster_the_wellbore_pressure_cannot_open_takes_nothing():
 
 def test_the_completion_table_reads_field_units():
     scene = completion('clusters = 5\nspacing = "50 ft"\nperforations = 6\nperforation_diameter = "0.42 in"\n'
-                       'discharge_coefficient = 0.8\nstress_offsets = ["0 psi", "0 psi", "100 psi", "0 psi", "0 psi"]\n')
+                       'discharge_coefficient = 0.8\n'
+                       'stress_offsets = ["0 psi", "0 psi", "100 psi", "0 psi", "0 psi"]\n')
     c = scene.completion
     assert c.clusters == 5 and c.limited_entry and c.perforations == (6,) * 5
     np.testing.assert_allclose(c.positions, np.arange(5) * 50 * 0.3048)
@@ -116,7 +117,8 @@ def test_bad_completions_are_one_line_errors(text, key, said):
 
 
 def test_clusters_outside_the_layer_table_are_refused():
-    text = FIELD_SCENE.replace('depth = "8000 ft"', 'depth = "9000 ft"') + '[completion]\nclusters = 2\nspacing = "60 ft"\n'
+    text = FIELD_SCENE.replace('depth = "8000 ft"', 'depth = "9000 ft"')
+    text += '[completion]\nclusters = 2\nspacing = "60 ft"\n'
     with pytest.raises(SceneError) as error:
         load_scene(text)
     assert error.value.path == "completion.clusters" and "outside the layer table" in str(error.value)
@@ -137,7 +139,8 @@ def test_several_clusters_are_refused_with_a_coarsened_grid():
 
 
 def test_a_stage_needs_fracture_alone():
-    text = FIELD_SCENE.replace('[run]\nend_time = "600 s"', '[run]\nend_time = "600 s"\nphysics = ["fracture", "proppant"]')
+    text = FIELD_SCENE.replace('[run]\nend_time = "600 s"',
+                               '[run]\nend_time = "600 s"\nphysics = ["fracture", "proppant"]')
     with pytest.raises(SceneError) as error:
         load_scene(text + '[completion]\nclusters = 2\nspacing = "60 ft"\n')
     assert any(e.path == "completion" and "physics" in e.allowed for e in getattr(error.value, "errors", [error.value]))

@@ -185,8 +185,9 @@ def cluster_rows(summary: dict[str, Any], system: str) -> list[tuple[str, str, s
     if n < 2:
         return []
     total = sum(float(summary[f"cluster_{i}_injected"]) for i in range(n))
-    return [("clusters", f"cluster {i + 1}", f"{format_number(100.0 * summary[f'cluster_{i}_injected'] / total, 3)} % of "
-             f"the fluid, area {_quantity(summary[f'cluster_{i}_area'], 'area', system)}, length "
+    share = [format_number(100.0 * summary[f"cluster_{i}_injected"] / total, 3) for i in range(n)]
+    return [("clusters", f"cluster {i + 1}", f"{share[i]} % of the fluid, area "
+             f"{_quantity(summary[f'cluster_{i}_area'], 'area', system)}, length "
              f"{_quantity(summary[f'cluster_{i}_length'], 'length', system)}, height "
              f"{_quantity(summary[f'cluster_{i}_height'], 'length', system)}") for i in range(n)]
 
