@@ -9,7 +9,8 @@ the rock's minimum stress on that cluster's plane (the perforation friction: hfg
 
 Refused before any work (one-line SceneError naming the key and the value): a count, a diameter or a spacing of 0,
 C_d outside (0, 1], two clusters at one position, a list of the wrong length, clusters at a depth outside the span
-of ``[[rock.layers]]``. Warned about: clusters closer than two cells (the larger of dx, dz in use) of the shared
+of ``[[rock.layers]]``, more than MAX_CLUSTERS clusters or a span over MAX_SPAN, a perforation friction that would
+not be finite. Warned about: clusters closer than two cells (the larger of dx, dz in use) of the shared
 fracture grid, where the shadow kernel between them is the near field of elements larger than their distance
 (tests/fracture/test_shadow.py measures its error on a penny crack's axis against the distance in cells).
 """
@@ -27,6 +28,9 @@ from .units import display_text
 
 #: Clusters closer than this many cells (the larger of dx, dz in use) are warned about.
 MIN_SPACING_CELLS = 2.0
+#: The most clusters a stage may have, and the longest span of their positions [m] (a lateral is a few km).
+MAX_CLUSTERS = 50
+MAX_SPAN = 1e4
 
 
 @dataclass(frozen=True)
@@ -80,6 +84,7 @@ def parse_completion(t: Table, depth: float, layers: tuple[Any, ...], cell: floa
         per_cluster["perforation_diameter"] = tuple(_each(t, "perforation_diameter", n, "length"))
         per_cluster["discharge_coefficient"] = tuple(_each(t, "discharge_coefficient", n, "dimensionless",
                                                            maximum=1.0))
+        _finite_friction(t, per_cluster)
     if t.has("stress_offsets"):
         per_cluster["stress_offsets"] = tuple(_each(t, "stress_offsets", n, "pressure", scalar=False))
     if layers:
@@ -96,6 +101,17 @@ def parse_completion(t: Table, depth: float, layers: tuple[Any, ...], cell: floa
     return Completion(positions=positions, **per_cluster)
 
 
+def _finite_friction(t: Table, per_cluster: dict[str, tuple]) -> None:
+    """n^2 d^4 C_d^2 of every cluster must be a positive finite number (the friction coefficient divides by it)."""
+    for i, (n, d, c) in enumerate(zip(per_cluster["perforations"], per_cluster["perforation_diameter"],
+                                      per_cluster["discharge_coefficient"])):
+        product = float(n) ** 2 * d**4 * c**2
+        if not 0.0 < product < float("inf"):
+            raw = t.data["perforation_diameter"]
+            raise SceneError(t.key_path("perforation_diameter"), raw[i] if isinstance(raw, list) else raw,
+                             "allowed: a diameter whose perforation friction is finite (n^2 d^4 C_d^2 > 0)")
+
+
 def _positions(t: Table) -> tuple[float, ...]:
     """``positions`` (a list of lengths), or ``clusters`` and ``spacing`` (positions 0, s, 2 s, ...)."""
     if t.has("positions"):
@@ -107,18 +123,28 @@ def _positions(t: Table) -> tuple[float, ...]:
         if not isinstance(raw, list) or not raw:
             raise SceneError(t.key_path("positions"), raw, 'expected a non-empty list of lengths along the well, '
                              'e.g. ["0 ft", "50 ft", "100 ft"]')
+        if len(raw) > MAX_CLUSTERS:
+            raise SceneError(t.key_path("positions"), raw, f"allowed: at most {MAX_CLUSTERS} clusters")
         positions = tuple(_item(t, "positions", i, v, "position") for i, v in enumerate(raw))
     else:
-        count = t.integer("clusters", 1, minimum=1)
+        count = t.integer("clusters", 1, minimum=1, maximum=MAX_CLUSTERS)
         spacing = t.quantity("spacing", "length", 0.0 if count == 1 else MISSING, minimum=0.0,
                              exclusive_minimum=count > 1)
         positions = tuple(i * spacing for i in range(count))
     order = np.argsort(positions, kind="stable")
     for i, j in zip(order, order[1:]):
         if positions[j] - positions[i] <= 1e-9 * max(1.0, abs(positions[j])):
-            raise SceneError(f"{t.key_path('positions')}[{j}]", t.data["positions"][j],
-                             f"clusters must not overlap: positions[{i}] is at the same place")
+            raise SceneError(*_where(t, j), f"clusters must not overlap: clusters {i} and {j} are at the same place")
+    if positions[order[-1]] - positions[order[0]] > MAX_SPAN:
+        raise SceneError(*_where(t, int(order[-1])), f"the clusters span more than {MAX_SPAN:g} m along the well")
     return positions
+
+
+def _where(t: Table, j: int) -> tuple[str, Any]:
+    """The key path and value an error about cluster j names: ``positions[j]``, or ``spacing``."""
+    if t.has("positions"):
+        return f"{t.key_path('positions')}[{j}]", t.data["positions"][j]
+    return t.key_path("spacing"), t.data.get("spacing")
 
 
 def _item(t: Table, key: str, i: int, value: Any, kind: str, **bounds: Any) -> float:
