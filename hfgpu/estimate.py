@@ -118,6 +118,8 @@ def estimate(scene: Any) -> Estimate | None:
 
     end = radial(t_pump)
     radius = float(end.R[-1])
+    if not (math.isfinite(radius) and math.isfinite(float(end.efficiency[-1]))):
+        return None   # the closed form overflows (an absurd modulus or rate): nothing to expect
     first: dict[str, tuple[float, float]] = {}
     for name, t in first_pumped(scene.injection.schedule).items():
         t_seen = max(t, 1e-3 * t_pump)  # sand from the first second: the opening a moment after it starts
