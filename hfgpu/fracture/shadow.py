@@ -135,6 +135,27 @@ class PlanesOperator:
             total = total + scipy.fft.rfft2(grid) * self._table_hat(spacing, shape)
         return scipy.fft.irfft2(total, s=shape)[iz - iz0, ix - ix0]
 
+    def shadow_fields(self, box: tuple[int, int, int, int], cells: list[tuple[np.ndarray, np.ndarray]],
+                      w: list[np.ndarray]) -> list[np.ndarray]:
+        """[sum_{l != k} C(k <- l) w_l at every cell of ``box`` for each plane k]: the shadow the other planes cast
+        on the whole box (ix0, iz0, nx, nz) of the shared grid, which holds every plane's ``cells``; (nz, nx) arrays,
+        by N forward FFTs, N (N - 1) spectral products and N inverse FFTs, O(N^2 M + N M log M)."""
+        ix0, iz0, nx, nz = box
+        shape = (scipy.fft.next_fast_len(2 * nz - 1, real=True), scipy.fft.next_fast_len(2 * nx - 1, real=True))
+        hats = []
+        for (ix, iz), wk in zip(cells, w):
+            grid = np.zeros(shape)
+            grid[np.asarray(iz) - iz0, np.asarray(ix) - ix0] = wk
+            hats.append(scipy.fft.rfft2(grid))
+        out = []
+        for k in range(len(cells)):
+            total = np.zeros_like(hats[0])
+            for m in range(len(cells)):
+                if m != k:
+                    total += hats[m] * self._table_hat(abs(float(self.positions[k] - self.positions[m])), shape)
+            out.append(scipy.fft.irfft2(total, s=shape)[:nz, :nx])
+        return out
+
     def dense(self, cells: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
         """The block matrix [C(k <- l)] over all planes' active cells, in the order of ``cells``, from
         :func:`offset_influence` directly (the oracle of ``matvec``)."""

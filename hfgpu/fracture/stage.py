@@ -99,6 +99,7 @@ class StageEngine:
         self.offsets = completion.offsets()
         self.operator = PlanesOperator(first.dx, first.dz, first.e_prime, completion.positions)
         self.sources = [self._widths(plane) for plane in self.planes]
+        self._shadow_fields()
         self.rates = np.full(n, self.pump.rate(self.t0) / n)   # the last pumping step's split
         self.step_rates = self.rates.copy()                      # the rates over the last step
         self.slopes: np.ndarray | None = None
@@ -118,8 +119,21 @@ class StageEngine:
         cells = [(s[0], s[1]) for s in sources]
         return self.operator.on_plane(k, (ix, iz), cells, [s[2] for s in sources])
 
+    def _shadow_fields(self) -> None:
+        """The shadow of the sources on every cell of the box that holds all planes' grids (``box``, ``fields``:
+        PlanesOperator.shadow_fields, N forward FFTs for all planes)."""
+        boxes = [(p.grid.ix0, p.grid.iz0, p.grid.shape[1], p.grid.shape[0]) for p in self.planes]
+        ix0, iz0 = min(b[0] for b in boxes), min(b[1] for b in boxes)
+        self.box = (ix0, iz0, max(b[0] + b[2] for b in boxes) - ix0, max(b[1] + b[3] for b in boxes) - iz0)
+        self.fields = self.operator.shadow_fields(self.box, [(s[0], s[1]) for s in self.sources],
+                                                  [s[2] for s in self.sources])
+
     def _shift(self, k: int, ix: np.ndarray, iz: np.ndarray) -> np.ndarray:
-        """_Engine.stress_shift of plane k: its offset and the shadow of the other planes' last iterate."""
+        """_Engine.stress_shift of plane k: its offset and the shadow of the other planes' last iterate (read from
+        ``fields``; on a cell a plane's grid has grown past ``box`` to during the step, computed there)."""
+        ix0, iz0, nx, nz = self.box
+        if np.all((ix >= ix0) & (ix < ix0 + nx) & (iz >= iz0) & (iz < iz0 + nz)):
+            return self.offsets[k] + self.fields[k][iz - iz0, ix - ix0]
         return self.offsets[k] + self._shadow(k, ix, iz, self.sources)
 
     def inlet_pressures(self) -> np.ndarray:
@@ -172,9 +186,10 @@ class StageEngine:
         """The node's next rates from the planes' inlet pressures after an iterate, and whether the iterate is
         converged (module docstring); the iterate's widths become the shadow's sources."""
         pressures, net = self.inlet_pressures(), self.net_pressures()
-        used = [self._shadow(k, p.ix, p.iz, self.sources) for k, p in enumerate(self.planes)]
+        used = [self._shift(k, p.ix, p.iz) for k, p in enumerate(self.planes)]
         self.sources = [self._widths(plane) for plane in self.planes]
-        change = max(float(np.max(np.abs(self._shadow(k, p.ix, p.iz, self.sources) - used[k]), initial=0.0))
+        self._shadow_fields()
+        change = max(float(np.max(np.abs(self._shift(k, p.ix, p.iz) - used[k]), initial=0.0))
                      / max(abs(float(net[k])), 1.0) for k, p in enumerate(self.planes))
         if q_total <= 0.0:
             self.p_wellbore = math.nan

@@ -157,7 +157,7 @@ def test_the_summary_table_has_a_row_per_cluster():
 @pytest.mark.slow
 def test_the_demo_stage_runs_within_its_budget(tmp_path):
     """demos/stage.py's stage (hfgpu/scenes/stage_demo.toml): complete well within issue 36's 5 minutes on 2 cores
-    (measured 33 s), every cluster's balance exact, the outer clusters take the most fluid and the limited entry
+    (measured 20 s), every cluster's balance exact, the outer clusters take the most fluid and the limited entry
     keeps every cluster's area within 15 % of the mean (measured: 0.934 to 1.076)."""
     import time
     from importlib import resources
