@@ -6,7 +6,7 @@ Cluster i is a fracture plane at the normal position y_i (its position along the
 injection cell at the same (x, z) on every plane, so the planes' cell indices are those of one grid. Plane i's
 system has the minimum stress
 
-    sigma_i(x, z) = sigma_0(z) + offset_i + sum_{l != i} C(i <- l) w_l          (shadow.PlanesOperator.on_plane)
+    sigma_i(x, z) = sigma_0(z) + offset_i + sum_{l != i} C(i <- l) w_l    (shadow.PlanesOperator.shadow_fields)
 
 and takes the rate q_i of the wellbore node (hfgpu.perforations): p_w = p_i(q_i) + a_i q_i^2, sum_i q_i = Q(t),
 p_i the fluid pressure in plane i's perforated cell.
