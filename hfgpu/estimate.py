@@ -3,8 +3,9 @@ form, the run's work (fracture cells, proppant steps, parcels), and the warnings
 
 The fracture is Dontsov's (2016) radial solution (:func:`hfgpu.reference.radial.dontsov_radial`, toughness,
 viscosity and Carter leak-off) with the rock at the injection depth (E' = E / (1 - nu^2), K' = 4 (2/pi)^1/2 K_Ic,
-C' = 2 C_L of that layer), mu' = 12 mu and the mean pumped rate Q = pumped volume / pumping time, at the end of
-pumping and when the first proppant is pumped. Layers are ignored: a height-contained fracture of the same volume
+C' = 2 C_L of that layer), mu' = 12 mu and the mean pumped rate Q = pumped volume / pumping time (over N for a
+stage of N clusters, ``[completion]``: each fracture an equal share), at the end of pumping and when the first
+proppant is pumped. Layers are ignored: a height-contained fracture of the same volume
 is longer and about as wide, so these are scales, not predictions.
 
 The work: the fracture grid's cells pi R^2 / (dx dz) at the end of pumping; the proppant fluid steps (end time -
@@ -102,6 +103,7 @@ def estimate(scene: Any) -> Estimate | None:
     if scene.rock is None or scene.injection is None or scene.fluid is None or not scene.has("fracture"):
         return None
     t_pump, volume = pumped(scene.injection.schedule)
+    volume /= _clusters(scene)   # a stage's clusters: each fracture an equal share
     if t_pump <= 0.0 or volume <= 0.0:
         return None
     from .reference.radial import dontsov_radial, scaled_parameters  # a fracture scene's: a proppant run needs none
@@ -116,6 +118,8 @@ def estimate(scene: Any) -> Estimate | None:
 
     end = radial(t_pump)
     radius = float(end.R[-1])
+    if not (math.isfinite(radius) and math.isfinite(float(end.efficiency[-1]))):
+        return None   # the closed form overflows (an absurd modulus or rate): nothing to expect
     first: dict[str, tuple[float, float]] = {}
     for name, t in first_pumped(scene.injection.schedule).items():
         t_seen = max(t, 1e-3 * t_pump)  # sand from the first second: the opening a moment after it starts
@@ -173,6 +177,12 @@ def closure_after(efficiency: float, pumping_time: float) -> float:
     return pumping_time * brentq(lambda d: float(G_function(d, CLOSURE_ALPHA)) - g_c, 0.0, upper, xtol=1e-12)
 
 
+def _clusters(scene: Any) -> int:
+    """The clusters of the scene's ``[completion]`` (1 without)."""
+    completion = getattr(scene, "completion", None)
+    return 1 if completion is None else completion.clusters
+
+
 def report(scene: Any, system: str) -> str:
     """The lines ``hfgpu check`` prints under "expected" ("" when :func:`estimate` has nothing to say)."""
     e = estimate(scene)
@@ -180,8 +190,10 @@ def report(scene: Any, system: str) -> str:
         return ""
     minutes = format_number(e.pumping_time / 60.0, 3)
     rate, radius = display_text(e.rate, "rate", system, DIGITS), display_text(e.radius, "length", system, DIGITS)
-    lines = [f"expected (a radial fracture at the mean rate {rate} in the rock at the injection depth, Dontsov 2016; "
-             "layers ignored; docs/scene.md):",
+    n = _clusters(scene)
+    share = f" (one of {n} clusters' equal shares)" if n > 1 else ""
+    lines = [f"expected (a radial fracture at the mean rate {rate}{share} in the rock at the injection depth, Dontsov "
+             "2016; layers ignored; docs/scene.md):",
              f"  {'at the end of pumping':32} {minutes} min: radius {radius}, "
              f"opening at the perforation {display_text(e.opening, 'width', system, DIGITS)}, fluid efficiency "
              f"{format_number(100.0 * e.efficiency, 2)} %",

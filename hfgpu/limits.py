@@ -69,8 +69,8 @@ def check_engine_start(scene) -> None:
 
 def _start_check(scene, engine) -> None:
     """The starting radial fracture (``fracture.initial_radius_cells`` x the larger cell in use) must form, at the
-    schedule's rates, within half the schedule and while a stage injects (as :func:`hfgpu.fracture.simulator.simulate`
-    requires)."""
+    schedule's rates (divided among the clusters of a stage), within half the schedule and while a stage injects
+    (as :func:`hfgpu.fracture.simulator.simulate` requires)."""
     import math
 
     K_PRIME_FACTOR, start_time = engine.K_PRIME_FACTOR, engine.start_time
@@ -78,7 +78,13 @@ def _start_check(scene, engine) -> None:
     r0 = numerics.initial_radius_cells * max(scene.mesh.dx, scene.mesh.dz)
     k0 = K_PRIME_FACTOR * float(rock.toughness_at(np.array(inj.depth)))
     c0 = 2.0 * float(rock.leakoff_at(np.array(inj.depth)))
-    t0, _ = start_time(inj.schedule, rock.plane_strain_modulus, 12.0 * scene.fluid.viscosity, k0, c0, r0)
+    schedule = inj.schedule
+    completion = getattr(scene, "completion", None)
+    if completion is not None and completion.clusters > 1:   # each cluster's fracture starts at Q / N
+        from .fracture.stage import ClusterInlet
+
+        schedule = ClusterInlet(schedule, 1.0 / completion.clusters)
+    t0, _ = start_time(schedule, rock.plane_strain_modulus, 12.0 * scene.fluid.viscosity, k0, c0, r0)
     if t0 >= 0.5 * inj.schedule.end or inj.schedule.rate(t0) <= 0.0:
         from .units import display_unit, format_number, in_display_units
 

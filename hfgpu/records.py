@@ -79,6 +79,27 @@ class BalanceRecord:
 
 
 @dataclass(frozen=True)
+class StageRecord:
+    """One accepted step of a stage of several clusters (hfgpu.fracture.stage): the wellbore pressure p_w [Pa]
+    (NaN while the pumps are stopped), each cluster's rate q_i [m^3/s] over the step and its own balance
+    record (its inlet pressure, net pressure, volumes and footprint)."""
+
+    time: float
+    wellbore_pressure: float
+    rates: np.ndarray
+    clusters: tuple[BalanceRecord, ...]
+
+
+@dataclass(frozen=True)
+class StageSnapshot:
+    """One cluster's fracture snapshot in a stage of several clusters: ``cluster`` its index in the order of
+    ``[completion] positions``."""
+
+    cluster: int
+    snapshot: FractureSnapshot
+
+
+@dataclass(frozen=True)
 class ProppantSnapshot:
     """Parcels and grid fields of the MP-PIC model at one time.
 

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .errors import HfgpuError
-from .simulators import SIMULATORS, NotSupportedError, check_supported
+from .simulators import NotSupportedError, check_supported, simulator_module
 from .interrupts import signal_number, stop_signals_interrupt
 from .io.sink import METHODS, FractureSink, ProppantSink
 from .scene import Scene
@@ -66,7 +66,7 @@ def warn_edited(scene: Scene) -> None:
 def simulator_for(scene: Scene) -> Callable[..., dict]:
     """The ``simulate`` function for the scene's physics set, imported now (and nothing else)."""
     check_supported(scene)
-    return importlib.import_module(SIMULATORS[tuple(scene.run.physics)]).simulate
+    return importlib.import_module(simulator_module(scene)).simulate
 
 
 def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = True,

@@ -5,7 +5,8 @@ Contract keys (outside tools rely on them; extend, never rename): ``[run] end_ti
 [[rock.layers]] top, bottom, min_stress, toughness, leakoff_coefficient, pore_pressure``; ``[fluid] viscosity,
 density``; ``[injection] depth, schedule = [{until, rate, proppant, volume_fraction, concentration,
 end_concentration}]``; ``[mesh] cell_size``; ``[output] every, units``; ``[geometry]`` and ``[[proppant]]``
-(see :mod:`hfgpu.proppant.config`); ``[closure]`` (see :mod:`hfgpu.closure.config`). Depth z is positive
+(see :mod:`hfgpu.proppant.config`); ``[closure]`` (see :mod:`hfgpu.closure.config`); ``[completion]`` (see
+:mod:`hfgpu.completion`). Depth z is positive
 downward; x is along the fracture length.
 
 Physics-specific sections are parsed by their own folder (``hfgpu.fracture.config``,
@@ -256,6 +257,7 @@ class Scene:
     coupling: Any = None  # hfgpu.coupled.CouplingConfig when physics has both "fracture" and "proppant"
     closure: Any = None  # hfgpu.closure.config.ClosureConfig when "proppant" in physics
     wellbore: Any = None  # hfgpu.wellbore.Wellbore when the scene has [wellbore] (with [injection])
+    completion: Any = None  # hfgpu.completion.Completion when the scene has [completion] (with "fracture")
     source: str = field(default="", repr=False, compare=False)  # the TOML text, stored in results
     #: One line each: what the scene reader found suspect but valid (bare numbers); hfgpu.scene_checks adds more.
     warnings: tuple[str, ...] = field(default=(), repr=False, compare=False)
@@ -419,6 +421,7 @@ def _parse(data: dict, source: str) -> Scene:
         top.raw("wellbore")
         if not top.has("injection"):
             sections.errors.append(SceneError("wellbore", "(table)", "this section needs [injection]"))
+    completion = _completion(top, sections, physics, injection, rock, mesh)
     if len(physics) > 1:
         if run is None or mesh is None:
             sections.skip("coupling")
@@ -438,8 +441,34 @@ def _parse(data: dict, source: str) -> Scene:
 
     scene = Scene(run=run, fluid=fluid, mesh=mesh, output=output, rock=rock, injection=injection,
                   fracture=fracture, proppant=proppant, coupling=coupling, closure=closure, wellbore=wellbore,
-                  source=source)
+                  completion=completion, source=source)
     return derive(scene, data, preset)[0]
+
+
+def _completion(top: Table, sections: _Sections, physics: tuple[str, ...], injection: Injection | None,
+                rock: Rock | None, mesh: Mesh | None):
+    """``[completion]`` (hfgpu.completion) when the scene has it: it needs run.physics = ["fracture"] (the proppant
+    of a stage is not run in this version), [injection], [rock] and [mesh], and no ``mesh.max_cells_across`` with
+    several clusters (the planes share one grid, which is not coarsened)."""
+    if not top.has("completion"):
+        return None
+    if physics != ("fracture",):
+        top.raw("completion")
+        sections.errors.append(SceneError("completion", "(table)", 'this section needs run.physics = ["fracture"] '
+                                          "(the proppant of a stage is not run in this version)"))
+        return None
+    if injection is None or rock is None or mesh is None:
+        sections.skip("completion")
+        return None
+    from .completion import parse_completion
+
+    completion = sections(("completion",), lambda: parse_completion(top.table("completion"), injection.depth,
+                                                                   rock.layers, max(mesh.dx, mesh.dz)))
+    if completion is not None and completion.clusters > 1 and mesh.max_cells_across is not None:
+        sections.errors.append(SceneError("mesh.max_cells_across", mesh.max_cells_across,
+                                          "not with several [completion] clusters: their planes share one grid, "
+                                          "which is not coarsened; remove it"))
+    return completion
 
 
 def _parse_run(t: Table) -> RunConfig:

@@ -13,6 +13,17 @@ SIMULATORS = {("fracture",): "hfgpu.fracture.simulator", ("proppant",): "hfgpu.p
               ("fracture", "proppant"): "hfgpu.coupled"}
 
 
+#: The module that runs a fracture scene with ``[completion]`` (a stage of N planes, N >= 1).
+STAGE_SIMULATOR = "hfgpu.fracture.stage"
+
+
+def simulator_module(scene: Any) -> str:
+    """The module of :data:`SIMULATORS` that runs ``scene``; :data:`STAGE_SIMULATOR` with ``[completion]``."""
+    if getattr(scene, "completion", None) is not None:
+        return STAGE_SIMULATOR
+    return SIMULATORS[tuple(scene.run.physics)]
+
+
 class NotSupportedError(HfgpuError, NotImplementedError):
     """The scene asks for something this version does not run yet."""
 

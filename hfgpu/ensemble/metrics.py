@@ -11,7 +11,9 @@ physics lacks it, e.g. proppant metrics of a fracture-only scene):
 * ``net_pressure_end`` [Pa]: the summary's ``net_pressure_end``, the last fracture step's net pressure at the
   injection cell (/fracture/balance);
 * ``efficiency`` [-]: the summary's fluid efficiency, stored / injected volume;
-* ``screened_out`` [-]: 1 when proppant was held back at the inlets (``proppant_screened_out`` > 0), else 0.
+* ``screened_out`` [-]: 1 when proppant was held back at the inlets (``proppant_screened_out`` > 0), else 0;
+* ``cluster_area_uniformity`` [-]: a stage of several clusters (``[completion]``): the smallest cluster's created
+  area over the clusters' mean (the summary's ``cluster_<i>_area``; 1: every cluster alike), NaN for one fracture.
 
 ``propped_map`` gives the member's cells propped after closure (``/closure`` ``propped``, the cells the
 ``propped_area`` counts) for the ensemble's probability maps.
@@ -27,7 +29,7 @@ NAN = float("nan")
 #: The unit of each metric (SI; "-" for a ratio or a flag).
 UNITS = {"created_area": "m^2", "propped_area": "m^2", "propped_area_in_place": "m^2", "propped_fraction": "-",
          "fracture_height": "m", "fracture_length": "m", "net_pressure_end": "Pa", "efficiency": "-",
-         "screened_out": "-"}
+         "screened_out": "-", "cluster_area_uniformity": "-"}
 
 
 def member_metrics(results) -> dict[str, float]:
@@ -40,7 +42,12 @@ def member_metrics(results) -> dict[str, float]:
     out = {"created_area": fracture("area"), "fracture_height": fracture("height"),
            "fracture_length": fracture("length"), "efficiency": float(s.get("efficiency", NAN)),
            "net_pressure_end": float(s.get("net_pressure_end", NAN)), "propped_area": NAN, "propped_fraction": NAN,
-           "propped_area_in_place": NAN, "screened_out": NAN}
+           "propped_area_in_place": NAN, "screened_out": NAN, "cluster_area_uniformity": NAN}
+    clusters: list[float] = []
+    while f"cluster_{len(clusters)}_area" in s:
+        clusters.append(float(s[f"cluster_{len(clusters)}_area"]))
+    if len(clusters) > 1:
+        out["cluster_area_uniformity"] = min(clusters) / float(np.mean(clusters))
     if len(results.proppant_snapshots):
         from ..propped import headline_propped
 

@@ -113,6 +113,49 @@ class PlanesOperator:
             out.append(scipy.fft.irfft2(total, s=shape)[np.asarray(iz) - iz0, np.asarray(ix) - ix0])
         return out
 
+    def on_plane(self, k: int, receivers: tuple[np.ndarray, np.ndarray], cells: list[tuple[np.ndarray, np.ndarray]],
+                 w: list[np.ndarray]) -> np.ndarray:
+        """sum_{l != k} C(k <- l) w_l on the cells ``receivers`` = (ix, iz) of plane k: the shadow the other planes
+        (``cells[l]``, ``w[l]``; plane k's own entries are not read) cast on it, by N - 1 forward FFTs, N - 1
+        spectral products and one inverse FFT over the common bounding box."""
+        others = [m for m in range(len(cells)) if m != k and len(cells[m][0])]
+        ix, iz = np.asarray(receivers[0]), np.asarray(receivers[1])
+        if not others or ix.size == 0:
+            return np.zeros(ix.size)
+        every = [cells[m] for m in others] + [(ix, iz)]
+        ix0, iz0 = min(int(np.min(c[0])) for c in every), min(int(np.min(c[1])) for c in every)
+        nx = max(int(np.max(c[0])) for c in every) - ix0 + 1
+        nz = max(int(np.max(c[1])) for c in every) - iz0 + 1
+        shape = (scipy.fft.next_fast_len(2 * nz - 1, real=True), scipy.fft.next_fast_len(2 * nx - 1, real=True))
+        total = 0.0
+        for m in others:
+            grid = np.zeros(shape)
+            grid[np.asarray(cells[m][1]) - iz0, np.asarray(cells[m][0]) - ix0] = w[m]
+            spacing = abs(float(self.positions[k] - self.positions[m]))
+            total = total + scipy.fft.rfft2(grid) * self._table_hat(spacing, shape)
+        return scipy.fft.irfft2(total, s=shape)[iz - iz0, ix - ix0]
+
+    def shadow_fields(self, box: tuple[int, int, int, int], cells: list[tuple[np.ndarray, np.ndarray]],
+                      w: list[np.ndarray]) -> list[np.ndarray]:
+        """[sum_{l != k} C(k <- l) w_l at every cell of ``box`` for each plane k]: the shadow the other planes cast
+        on the whole box (ix0, iz0, nx, nz) of the shared grid, which holds every plane's ``cells``; (nz, nx) arrays,
+        by N forward FFTs, N (N - 1) spectral products and N inverse FFTs, O(N^2 M + N M log M)."""
+        ix0, iz0, nx, nz = box
+        shape = (scipy.fft.next_fast_len(2 * nz - 1, real=True), scipy.fft.next_fast_len(2 * nx - 1, real=True))
+        hats = []
+        for (ix, iz), wk in zip(cells, w):
+            grid = np.zeros(shape)
+            grid[np.asarray(iz) - iz0, np.asarray(ix) - ix0] = wk
+            hats.append(scipy.fft.rfft2(grid))
+        out = []
+        for k in range(len(cells)):
+            total = np.zeros_like(hats[0])
+            for m in range(len(cells)):
+                if m != k:
+                    total += hats[m] * self._table_hat(abs(float(self.positions[k] - self.positions[m])), shape)
+            out.append(scipy.fft.irfft2(total, s=shape)[:nz, :nx])
+        return out
+
     def dense(self, cells: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
         """The block matrix [C(k <- l)] over all planes' active cells, in the order of ``cells``, from
         :func:`offset_influence` directly (the oracle of ``matvec``)."""

@@ -163,6 +163,9 @@ class _Engine:
 
     def __init__(self, scene, numerics: FractureNumerics, slurry: Slurry | None = None):
         self.scene, self.num, self.slurry = scene, numerics, slurry
+        #: Extra normal stress [Pa] on the active cells (ix, iz), added to sigma_0 in each step's system (the
+        #: shadow of the other planes and a cluster's offset, stage.py); None: none.
+        self.stress_shift: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
         rock, inj = scene.rock, scene.injection
         self.dx, self.dz = scene.mesh.dx, scene.mesh.dz
         self.area = self.dx * self.dz
@@ -319,7 +322,8 @@ class _Engine:
         else:
             demand = carter_volume(self.cprime_a, tau, self.t, self.t + dt, filled)
         w_eps = np.maximum(self.num.leakoff_width_fraction * demand, 1e-2 * float(w_old.max()))
-        prob = StepProblem(self.ix, self.iz, w_old, self.sigma_a, self.faces, self.area, dt, source,
+        sigma = self.sigma_a if self.stress_shift is None else self.sigma_a + self.stress_shift(self.ix, self.iz)
+        prob = StepProblem(self.ix, self.iz, w_old, sigma, self.faces, self.area, dt, source,
                            demand, w_eps, 1e-3 * float(w_old.max()), pinned, wetted, self.closure_width, contact)
         if w_start is not None:
             first = np.where(w_start > 0.0, w_start, start_widths(prob))

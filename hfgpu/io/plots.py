@@ -10,7 +10,8 @@ parcels coloured by radius, solid balance. Coupled runs (both physics) add the p
 fraction and speed maps over time, fluid streamlines, |u_p| probability plots at 1260 / 1800 / 3600 s (nearest
 snapshots), fracture and propped area vs time. Runs with proppant add the propped width and conductivity after
 closure (hfgpu.closure). A proppant-only column (at most MAX_COLUMN_CELLS columns, taller than wide) adds its
-interface heights against time.
+interface heights against time. A stage of several clusters adds the split of the rate and the fluid among its
+clusters, their areas and pressures, and one width map per cluster at the last snapshot.
 Every figure draws in the results' ``[output] units`` (:mod:`hfgpu.io.display_units`: SI as stored, widths in
 mm, pressures in MPa; or field: ft, in, psi, bbl, ft^3, ft^2, ft/s); times stay in s. Functions that take a results
 file read its units (``units=`` overrides them); those that take a snapshot draw SI unless given ``units``.
@@ -299,6 +300,54 @@ def pressure_history(results: Results, units: FigureUnits | None = None) -> Figu
     for axis, values in ((right.xaxis, t[positive]), (right.yaxis, net[positive])):
         _log_ticks(axis, values)
     right.set(xlabel="time [s]", ylabel=label, title="log-log while pumping (Nolte-Smith)")
+    return fig
+
+
+def stage_split(results: Results, units: FigureUnits | None = None) -> Figure:
+    """A stage of several clusters (``/stage/balance``): each cluster's rate against time (stacked: they sum to
+    the pump rate), its share of the fluid pumped so far, its created area, and the wellbore pressure with each
+    cluster's inlet pressure (the difference is its perforation friction)."""
+    u = _units(results, units)
+    b = results.stage_balance
+    t, n = b["time"], b["rate"].shape[1]
+    labels = [f"cluster {i + 1}" for i in range(n)]
+    fig = Figure(figsize=(12, 8), layout="constrained")
+    (rates, shares), (areas, pressures) = fig.subplots(2, 2)
+    rates.stackplot(t, *u("rate", b["rate"]).T, labels=labels, step="pre")
+    rates.set(xlabel="time [s]", ylabel=f"cluster rate [{u.label('rate')}]", title="split of the pump rate")
+    rates.legend(fontsize="small")
+    total = b["injected"].sum(axis=1)
+    pumped = total > 0
+    for i in range(n):
+        shares.plot(t[pumped], b["injected"][pumped, i] / total[pumped], label=labels[i])
+        areas.plot(t, u("area", b["area"][:, i]), label=labels[i])
+    shares.set(xlabel="time [s]", ylabel="share of the fluid pumped [-]", title="split of the fluid so far")
+    areas.set(xlabel="time [s]", ylabel=f"created area (one face) [{u.label('area')}]", title="area per cluster")
+    pressures.plot(t, u("pressure", b["wellbore_pressure"]), "k", lw=2, label="wellbore")
+    for i in range(n):
+        pressures.plot(t, u("pressure", b["injection_pressure"][:, i]), label=f"{labels[i]} inlet")
+    pressures.set(xlabel="time [s]", ylabel=f"pressure [{u.label('pressure')}]",
+                  title="wellbore and cluster inlet pressures")
+    for ax in (shares, areas, pressures):
+        ax.legend(fontsize="small")
+    return fig
+
+
+def stage_widths(results: Results, units: FigureUnits | None = None) -> Figure:
+    """One panel per cluster of a stage (``/stage/cluster_<i>/snapshots``): its width map at the last snapshot,
+    all on one colour scale, titled with its share of the fluid pumped and its created area."""
+    u = _units(results, units)
+    snaps = [clusters[-1] for clusters in results.stage_snapshots]
+    fig = Figure(figsize=(3.6 * len(snaps), 4.2), layout="constrained")
+    axes = fig.subplots(1, len(snaps), squeeze=False)[0]
+    limits = colour_range(*(u("width", snap.width) for snap in snaps))
+    total = sum(float(snap.extras["injected_volume"]) for snap in snaps)
+    for n, (ax, snap) in enumerate(zip(axes, snaps)):
+        share = float(snap.extras["injected_volume"]) / total if total > 0 else math.nan
+        area = float(u("area", float(snap.extras["area"])))
+        _map(fig, ax, snap.frame, u("width", snap.width), f"width [{u.label('width')}]",
+             f"cluster {n + 1}: {_number(100 * share, '.3g')} % of the fluid\narea {_number(area)} "
+             f"{u.label('area')}, t = {_number(snap.time)} s", limits, colourbar=n == len(snaps) - 1, units=u)
     return fig
 
 
@@ -706,6 +755,10 @@ def figures(results: Results, units: FigureUnits | None = None) -> dict[str, Fig
         analysis = falloff(results)
         if analysis is not None:  # a run with a shut-in (records after the pumps stop)
             out["fall_off"] = fall_off(results, units=u, analysis=analysis)
+    if results.stage_balance:
+        out["stage_split"] = stage_split(results, units=u)
+    if results.stage_snapshots:
+        out["stage_widths"] = stage_widths(results, units=u)
     if len(results.proppant_snapshots):
         last = results.proppant_snapshots[-1]
         out.update(proppant_volume_fraction=volume_fraction_map(last, layers, u),
@@ -739,6 +792,7 @@ FIGURE_NAMES = {
                  "proppant_volume_balance"),
     "column": ("proppant_interfaces",),
     "coupled": ("proppant_maps", "proppant_streamlines", "proppant_speed_probability", "propped_area"),
+    "stage": ("stage_split", "stage_widths"),
 }
 
 

@@ -8,6 +8,8 @@ Layout (docs/results-format.md is the full contract; extend, never rename)::
     /fracture/balance       time, injected, stored, leaked, ..., surface_pressure with [wellbore] (1-D, appended)
     /proppant/snapshots/000000 ...   attrs time, dx, dz, x0, z0, n_parcels; per-parcel and grid datasets
     /proppant/balance       time, injected, in_domain, outflow, screened_out (1-D, appended)
+    /stage/balance          time, wellbore_pressure (1-D); rate, injection_pressure, ... (rows x clusters), a stage
+    /stage/cluster_<i>/snapshots/000000 ...   each cluster's fracture snapshots, as /fracture/snapshots
     /summary                attrs status, message, and the simulator's scalar summary values
     /closure                attrs dx, dz, x0, z0, time and the closure scalars; propped_width, conductivity, ...
     /checkpoint             attrs time and record counts; state/...: the simulator's state (removed when complete)
@@ -55,7 +57,7 @@ except ImportError:  # not POSIX
 from ..errors import HfgpuError
 from .checkpoint import read_tree, write_tree
 from ..records import (BalanceRecord, FractureSnapshot, GridFrame, ProppantSnapshot,
-                       SolidBalanceRecord)
+                       SolidBalanceRecord, StageRecord, StageSnapshot)
 
 FORMAT = "hfgpu-results"
 FORMAT_VERSION = 1
@@ -71,7 +73,7 @@ UNITS = {
     "net_pressure": "Pa", "min_stress": "Pa", "toughness": "Pa m^0.5", "leakoff_coefficient": "m/s^0.5",
     "x": "m", "z": "m", "u": "m/s", "v": "m/s", "radius": "m", "density": "kg/m^3", "particles": "1",
     "state": "1", "class_id": "1", "volume_fraction": "1", "fluid_u": "m/s", "fluid_v": "m/s",
-    "bridging_risk": "1",
+    "bridging_risk": "1", "wellbore_pressure": "Pa", "rate": "m^3/s",
     "scene": "",
     # the fracture engine's scalar snapshot extras (docs/results-format.md)
     **{f"front_{k}": "m" for k in ("radius", "radius_min", "radius_max", "up", "down", "left", "right")},
@@ -89,6 +91,10 @@ FRACTURE_BALANCE = ("time", "injected", "stored", "leaked", "injection_pressure"
 #: The fracture balance column a scene with ``[wellbore]`` adds after FRACTURE_BALANCE: the STP of each row.
 SURFACE_PRESSURE = "surface_pressure"
 PROPPANT_BALANCE = ("time", "injected", "in_domain", "outflow", "screened_out")
+#: The per-cluster columns of ``/stage/balance`` (a stage of several clusters, hfgpu.fracture.stage): each a
+#: (rows, clusters) dataset, after the 1-D ``time`` and ``wellbore_pressure``.
+STAGE_CLUSTER_COLUMNS = ("rate", "injection_pressure", "net_pressure", "injected", "stored", "leaked", "area",
+                         "length", "height", "inlet_width")
 _BALANCE_FLUSH_ROWS = 4096
 _COMPRESS_ABOVE = 4096  # elements; smaller arrays are stored plainly
 
@@ -303,7 +309,7 @@ class ResultsWriter:
         self.path = path
         self._surface = surface_pressure_of(scene)   # None without [wellbore]
         self._counts = counts
-        self._pending: dict[str, list[tuple[float, ...]]] = {"fracture": [], "proppant": []}
+        self._pending: dict[str, list[tuple[float, ...]]] = {"fracture": [], "proppant": [], "stage": []}
         self._last_time = last_time
         self._closed = False
         self._file = _TwinFile(path)
@@ -359,12 +365,21 @@ class ResultsWriter:
 
     def fracture_snapshot(self, snap: FractureSnapshot) -> None:
         """Write one fracture snapshot (and the buffered balance records)."""
+        self._fracture_snapshot("fracture", snap)
+
+    def stage_snapshot(self, record: StageSnapshot) -> None:
+        """Write one cluster's fracture snapshot of a stage, as ``/stage/cluster_<i>/snapshots/<k>``."""
+        group = f"stage/cluster_{record.cluster}"
+        self._counts.setdefault(group, 0)
+        self._fracture_snapshot(group, record.snapshot)
+
+    def _fracture_snapshot(self, group: str, snap: FractureSnapshot) -> None:
         fields = {name: getattr(snap, name) for name in FRACTURE_FIELDS}
         clash = set(snap.extras) & set(fields)
         if clash:
             raise HfgpuError(f"fracture snapshot extras {sorted(clash)} clash with the standard fields")
         fields.update(snap.extras)
-        self._snapshot("fracture", snap.time, snap.frame, {k: (v, "grid") for k, v in fields.items()}, {})
+        self._snapshot(group, snap.time, snap.frame, {k: (v, "grid") for k, v in fields.items()}, {})
 
     def proppant_snapshot(self, snap: ProppantSnapshot) -> None:
         """Write one proppant snapshot: per-parcel datasets (kind "parcel") and grid datasets (kind "grid")."""
@@ -383,6 +398,14 @@ class ResultsWriter:
     def proppant_balance(self, record: SolidBalanceRecord) -> None:
         """Buffer one solid balance row; rows are written with the next snapshot or at close."""
         self._balance("proppant", tuple(float(getattr(record, k)) for k in PROPPANT_BALANCE))
+
+    def stage_record(self, record: StageRecord) -> None:
+        """Buffer one stage row (time, wellbore pressure, then each of STAGE_CLUSTER_COLUMNS for every cluster);
+        rows are written with the fracture rows."""
+        per_cluster = [record.rates] + [[getattr(c, name) for c in record.clusters]
+                                        for name in STAGE_CLUSTER_COLUMNS[1:]]
+        self._balance("stage", (float(record.time), float(record.wellbore_pressure),
+                                *(float(v) for column in per_cluster for v in column)))
 
     def write_checkpoint(self, time: float, state: dict) -> None:
         """Replace ``/checkpoint`` with the simulator's ``state`` at simulated time ``time`` [s], after writing the
@@ -533,7 +556,10 @@ class ResultsWriter:
 
 def _append_rows(f: h5py.File, rows: dict[str, np.ndarray]) -> None:
     """Append balance rows ({physics: (rows, columns) array}) to ``/<physics>/balance``, one dataset per column
-    (fracture rows without the STP column leave ``surface_pressure`` out: zip stops at the last column)."""
+    (fracture rows without the STP column leave ``surface_pressure`` out: zip stops at the last column); a stage's
+    rows to ``/stage/balance`` (:func:`_append_stage`)."""
+    if "stage" in rows:
+        _append_stage(f, rows["stage"])
     for physics, names in (("fracture", FRACTURE_BALANCE + (SURFACE_PRESSURE,)), ("proppant", PROPPANT_BALANCE)):
         if physics not in rows:
             continue
@@ -544,6 +570,23 @@ def _append_rows(f: h5py.File, rows: dict[str, np.ndarray]) -> None:
             ds = group[name]
             ds.resize((ds.shape[0] + column.size,))
             ds[-column.size:] = column
+
+
+def _append_stage(f: h5py.File, rows: np.ndarray) -> None:
+    """Stage rows (:meth:`ResultsWriter.stage_record`) as ``/stage/balance``: ``time`` and ``wellbore_pressure``
+    1-D, each of STAGE_CLUSTER_COLUMNS (rows, clusters)."""
+    clusters = (rows.shape[1] - 2) // len(STAGE_CLUSTER_COLUMNS)
+    group = f.require_group("stage/balance")
+    columns = {"time": rows[:, 0], "wellbore_pressure": rows[:, 1]}
+    for k, name in enumerate(STAGE_CLUSTER_COLUMNS):
+        columns[name] = rows[:, 2 + k * clusters:2 + (k + 1) * clusters]
+    for name, column in columns.items():
+        if name not in group:
+            _dataset(group, name, np.zeros((0,) + column.shape[1:]), maxshape=(None,) + column.shape[1:],
+                     chunks=(1024,) + column.shape[1:])
+        ds = group[name]
+        ds.resize((ds.shape[0] + column.shape[0],) + column.shape[1:])
+        ds[-column.shape[0]:] = column
 
 
 def _array(value: Any) -> np.ndarray:
@@ -618,6 +661,10 @@ class Results:
     summary: the ``/summary`` attributes (empty until the run closed the file).
     fracture_balance / proppant_balance: dicts of 1-D arrays (empty dict when absent).
     checkpoint_time: simulated time [s] of the checkpoint the file holds (None when it holds none).
+    stage_balance: ``/stage/balance`` of a stage of several clusters (1-D ``time``, ``wellbore_pressure``; the
+    per-cluster columns (rows, clusters)); empty dict otherwise.
+    stage_snapshots: each cluster's fracture snapshots of a stage (``/stage/cluster_<i>/snapshots``); empty
+    otherwise.
     """
 
     path: Path
@@ -630,6 +677,8 @@ class Results:
     fracture_balance: dict[str, np.ndarray] = field(repr=False)
     proppant_balance: dict[str, np.ndarray] = field(repr=False)
     checkpoint_time: float | None = None
+    stage_balance: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
+    stage_snapshots: list[Snapshots] = field(default_factory=list, repr=False)
 
     @functools.cached_property
     def closure(self) -> dict[str, Any] | None:
@@ -672,7 +721,19 @@ def open_results(path: str | Path) -> Results:
             fracture_balance=_balance(f, "fracture"),
             proppant_balance=_balance(f, "proppant"),
             checkpoint_time=_checkpoint_time(f),
+            stage_balance=_balance(f, "stage"),
+            stage_snapshots=[_snapshots(f, path, f"stage/cluster_{i}", _fracture_snapshot)
+                             for i in range(_stage_clusters(f))],
         )
+
+
+def _stage_clusters(f: h5py.File) -> int:
+    """The clusters with snapshots under ``/stage`` (``cluster_0``, ``cluster_1``, ...)."""
+    group = f.get("stage")
+    n = 0
+    while group is not None and f"cluster_{n}" in group:
+        n += 1
+    return n
 
 
 def _checkpoint_time(f: h5py.File) -> float | None:

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from ..records import BalanceRecord, FractureSnapshot, ProppantSnapshot, SolidBalanceRecord
+from ..records import (BalanceRecord, FractureSnapshot, ProppantSnapshot, SolidBalanceRecord, StageRecord,
+                       StageSnapshot)
 
 
 class FractureSink(Protocol):
@@ -30,9 +31,19 @@ class ProppantSink(Protocol):
     def proppant_balance(self, record: SolidBalanceRecord) -> None: ...
 
 
+class StageSink(Protocol):
+    """Takes a stage's records (hfgpu.fracture.stage, several clusters): one every accepted time step, beside the
+    stage's fracture balance record, and each cluster's snapshot at every output time."""
+
+    def stage_record(self, record: StageRecord) -> None: ...
+
+    def stage_snapshot(self, record: StageSnapshot) -> None: ...
+
+
 class ResultsSink(FractureSink, ProppantSink, Protocol):
     """Takes the records of either simulator (a coupled run's)."""
 
 
 #: the methods of a ResultsSink, in the order of hfgpu.records
-METHODS = tuple(name for proto in (FractureSink, ProppantSink) for name in vars(proto) if not name.startswith("_"))
+METHODS = tuple(name for proto in (FractureSink, ProppantSink, StageSink) for name in vars(proto)
+                if not name.startswith("_"))

@@ -15,6 +15,7 @@ screen-out that did not happen, reads "never"):
   saying why none was picked;
 * fluid: pumped, in the fracture, leaked off, fluid efficiency, bottom-hole treating pressure (BHTP) at the end,
   and with ``[wellbore]`` the surface treating pressure (STP, :mod:`hfgpu.wellbore`) at the end;
+* clusters (a stage of several, ``[completion]``): each cluster's share of the fluid, created area, length, height;
 * proppant: pumped, in the fracture (in the domain, for a proppant-only run), held back at the inlet (screen-out) and when it began, left the domain, parcels,
   and the closure results (propped area after closure, hfgpu.propped.headline_propped, and its share of the created
   area, propped half-length and height, mean
@@ -42,7 +43,7 @@ from ..closure.display import unit_label as closure_unit
 from ..units import display_unit, format_number, in_display_units
 
 #: The groups in the order they are printed.
-GROUPS = ("fracture", "end of pumping", "fall-off", "fluid", "proppant", "run")
+GROUPS = ("fracture", "end of pumping", "fall-off", "fluid", "clusters", "proppant", "run")
 
 
 def _first(summary: dict, *keys: str) -> Any:
@@ -175,6 +176,22 @@ def surface_history(balance: dict[str, np.ndarray] | None, scene: Any) -> np.nda
     return surface_pressure(scene, balance["time"], balance["injection_pressure"])
 
 
+def cluster_rows(summary: dict[str, Any], system: str) -> list[tuple[str, str, str]]:
+    """The "clusters" group of a stage of several clusters (``cluster_<i>_*`` of the summary, hfgpu.fracture.stage):
+    one row per cluster, its share of the fluid pumped, its created area, length and height at the end."""
+    n = 0
+    while f"cluster_{n}_area" in summary:
+        n += 1
+    if n < 2:
+        return []
+    total = sum(float(summary[f"cluster_{i}_injected"]) for i in range(n))
+    share = [format_number(100.0 * summary[f"cluster_{i}_injected"] / total, 3) for i in range(n)]
+    return [("clusters", f"cluster {i + 1}", f"{share[i]} % of the fluid, area "
+             f"{_quantity(summary[f'cluster_{i}_area'], 'area', system)}, length "
+             f"{_quantity(summary[f'cluster_{i}_length'], 'length', system)}, height "
+             f"{_quantity(summary[f'cluster_{i}_height'], 'length', system)}") for i in range(n)]
+
+
 def summary_rows(summary: dict[str, Any], system: str = "SI", density: float | None = None,
                  pressures: dict[str, float] | None = None,
                  stp_end: float | None = None, falloff: Any = None) -> list[tuple[str, str, str]]:
@@ -219,6 +236,8 @@ def summary_rows(summary: dict[str, Any], system: str = "SI", density: float | N
     add("fluid", "BHTP (bottom-hole treating pressure), end", _quantity(s.get("injection_pressure_end"), "pressure",
                                                                          system))
     add("fluid", "STP (surface treating pressure), end", _quantity(stp_end, "pressure", system))
+
+    rows += cluster_rows(s, system)
 
     pumped = s.get("proppant_injected")
     add("proppant", "pumped", _proppant_amount(pumped, density, system))
