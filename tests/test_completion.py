@@ -105,10 +105,10 @@ def test_the_completion_table_reads_field_units():
     ('clusters = 3\nspacing = "50 ft"\nperforations = 6\nperforation_diameter = "0.4 in"\ndischarge_coefficient = 0',
      "completion.discharge_coefficient", "> 0"),
     ('positions = ["0 ft", "50 ft", "50 ft"]', "completion.positions[2]", "must not overlap"),
-    ('clusters = 3\nspacing = "5e-324 m"', "completion.spacing", "must not overlap"),
+    ('clusters = 3\nspacing = "1e-12 m"', "completion.spacing", "must not overlap"),
     ('clusters = 3\nspacing = "1e300 m"', "completion.spacing", "span more than"),
     ('clusters = 1000000000000000000\nspacing = "50 ft"', "completion.clusters", "<= 50"),
-    ('clusters = 2\nspacing = "50 ft"\nperforations = 6\nperforation_diameter = "5e-324 m"\n'
+    ('clusters = 2\nspacing = "50 ft"\nperforations = 6\nperforation_diameter = "1e-100 m"\n'
      'discharge_coefficient = 0.8', "completion.perforation_diameter", "finite"),
     ('clusters = 3\nspacing = "0 ft"', "completion.spacing", "> 0"),
     ('clusters = 2\nspacing = "50 ft"\nperforations = [6, 6, 6]\nperforation_diameter = "0.4 in"\n'
