@@ -259,10 +259,15 @@ class Scene:
     wellbore: Any = None  # hfgpu.wellbore.Wellbore when the scene has [wellbore] (with [injection])
     completion: Any = None  # hfgpu.completion.Completion when the scene has [completion] (with "fracture")
     source: str = field(default="", repr=False, compare=False)  # the TOML text, stored in results
+    #: The TOML text parsed (read-only; {} for a scene built in code): which keys the scene gives.
+    document: dict = field(default_factory=dict, repr=False, compare=False)
     #: One line each: what the scene reader found suspect but valid (bare numbers); hfgpu.scene_checks adds more.
     warnings: tuple[str, ...] = field(default=(), repr=False, compare=False)
     #: The knobs given defaults from the scene's own scales (hfgpu.defaults.Derived: key, value, reason).
     derived: tuple[Any, ...] = field(default=(), repr=False, compare=False)
+    #: What hfgpu.estimate expects of the scene (hfgpu.estimate.Estimate), set by hfgpu.scene_checks.validate; None
+    #: before it or when there is nothing to expect.
+    expected: Any = field(default=None, repr=False, compare=False)
 
     def has(self, physics: str) -> bool:
         return physics in self.run.physics
@@ -312,7 +317,7 @@ def parse_scene(data: dict, source: str = "") -> Scene:
     ``[rock]``; ``[coupling]`` needs ``[run]`` and ``[mesh]``) is skipped, so that one mistake is reported once. The
     warnings found while reading (bare numbers, :mod:`hfgpu.scene_reader`; gaps between layers; high proppant
     concentrations) are in ``Scene.warnings``. Bare numbers are judged by the scene's unit system
-    (:func:`unit_system`).
+    (:func:`unit_system`). ``data`` is kept as ``Scene.document`` (not copied: the caller hands it over).
     """
     with collecting_warnings(unit_system(data)) as found:
         scene = _parse(data, source)
@@ -441,7 +446,7 @@ def _parse(data: dict, source: str) -> Scene:
 
     scene = Scene(run=run, fluid=fluid, mesh=mesh, output=output, rock=rock, injection=injection,
                   fracture=fracture, proppant=proppant, coupling=coupling, closure=closure, wellbore=wellbore,
-                  completion=completion, source=source)
+                  completion=completion, source=source, document=data)
     return derive(scene, data, preset)[0]
 
 
