@@ -53,10 +53,10 @@ import numpy as np
 
 from .coupling import FractureHistory, proppant_frame, screen_out_cells
 from .coupling_config import DEFAULT_INLET_CELLS
+from .engines import FractureEngine, ProppantEngine
 from .errors import SceneError
 from .fracture.mesh import injection_cell_centre
 from .fracture.simulator import FractureRun, simulate as simulate_fracture
-from .fracture.slurry import held_tips
 from .io.progress import shifted
 from .io.sink import FractureSink, ProppantSink, ResultsSink
 from .proppant.config import Geometry, Port
@@ -124,6 +124,20 @@ def proppant_scene(scene: Scene, frame: GridFrame, shape: tuple[int, int], width
         injection=dataclasses.replace(inj, schedule=shifted_schedule(inj.schedule, start)),
         proppant=dataclasses.replace(scene.proppant, geometry=geometry),
         mesh=dataclasses.replace(scene.mesh, dx=frame.dx, dz=frame.dz))
+
+
+def proppant_simulation(scene: Scene, frame: GridFrame, shape: tuple[int, int], start: float,
+                        width_at: Callable[[float], tuple[np.ndarray, np.ndarray]],
+                        timings: Timings) -> ProppantSimulation:
+    """The proppant run of the coupled scene from ``start`` (:func:`proppant_scene`; its clock is 0 there) on the
+    grid (frame, shape), its walls ``width_at(t)`` = (width, leak-off rate) at the scene's time t, its fluid and
+    parcel steps timed into ``timings``."""
+    sim = ProppantSimulation(proppant_scene(scene, frame, shape, width_at(start)[0], start),
+                             width_field=lambda t: width_at(t + start))
+    sim.watch.offset = start
+    sim.solver.step = timings.wrap("fluid", sim.solver.step)
+    sim.engine.substeps = timings.wrap("parcels", sim.engine.substeps)
+    return sim
 
 
 class Timings:
@@ -270,12 +284,7 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
     timings.seconds["fracture"] += _time.perf_counter() - t0 - timings.seconds["io"]
     start = late_start(scene, start, float(history.times[0]))
     frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=injection_cell_centre(scene))
-    field = history.width_field(frame, shape, cfg.min_width)
-    sub = proppant_scene(scene, frame, shape, field(start)[0], start)
-    sim = ProppantSimulation(sub, width_field=lambda t: field(t + start))
-    sim.watch.offset = start
-    sim.solver.step = timings.wrap("fluid", sim.solver.step)
-    sim.engine.substeps = timings.wrap("parcels", sim.engine.substeps)
+    sim = proppant_simulation(scene, frame, shape, start, history.width_field(frame, shape, cfg.min_width), timings)
     shift = _ProppantShift(sink, start, scene.proppant.params.bridging_factor, timings)
     if phase == "proppant":
         shift.restore(resume["screen_out"])
@@ -334,7 +343,7 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
     timings.seconds["footprint"] += _time.perf_counter() - t0
 
     tee = _FractureTee(sink, timings)
-    run = FractureRun(fracture_scene, tee, progress)
+    run: FractureEngine = FractureRun(fracture_scene, tee, progress)
 
     def advance_fracture(until: float) -> None:
         t_a, io = _time.perf_counter(), timings.seconds["io"]
@@ -343,11 +352,7 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
 
     advance_fracture(start)
     geometry = {"width": FractureHistory(tee.snapshots).width_field(frame, shape, cfg.min_width)}
-    sim = ProppantSimulation(proppant_scene(scene, frame, shape, geometry["width"](start)[0], start),
-                             width_field=lambda t: geometry["width"](t + start))
-    sim.watch.offset = start
-    sim.solver.step = timings.wrap("fluid", sim.solver.step)
-    sim.engine.substeps = timings.wrap("parcels", sim.engine.substeps)
+    sim: ProppantEngine = proppant_simulation(scene, frame, shape, start, lambda t: geometry["width"](t), timings)
     shift = _ProppantShift(sink, start, params.bridging_factor, timings)
     every = cfg.fracture_every
     ends = [every * k for k in range(int(math.floor(start / every + 1e-9)) + 1,
@@ -359,10 +364,10 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
         geometry["width"] = FractureHistory(tee.snapshots).width_field(frame, shape, cfg.min_width)
         sim.advance(t_next - start, shift)
         t_a = _time.perf_counter()
-        run.engine.use_slurry(slurry_of(sim.snapshot(), params))
+        run.use_slurry(slurry_of(sim.snapshot(), params))
         timings.seconds["feedback"] += _time.perf_counter() - t_a
         p_net = tee.last.net_pressure
-        if math.isnan(t_screen_out) and held_tips(run.engine.grid["active"], run.engine.blocked_box):
+        if math.isnan(t_screen_out) and run.tips_held():
             t_screen_out, p_screen_out = t_next, p_net
         if not math.isnan(t_screen_out):
             p_max = max(p_max, p_net)

@@ -138,7 +138,8 @@ class StepInfo:
 
 
 class ProppantSimulation:
-    """State and stepping of one MP-PIC run; :func:`simulate` drives it to the end time.
+    """State and stepping of one MP-PIC run (a :class:`hfgpu.engines.ProppantEngine`); :func:`simulate` drives it
+    to the end time.
 
     Attributes a caller may read: ``time``, ``grid``, ``parcels`` (:class:`Parcels`), ``fluid`` (the fluid
     solver's state), ``injected``, ``outflow``, ``screened_out`` [m^3] (solids), ``screen_out_time`` [s] (first
