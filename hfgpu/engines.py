@@ -42,6 +42,10 @@ class ProppantEngine(Protocol):
     def time(self) -> float:
         """Its clock [s] (0 at the proppant start of a coupled run)."""
 
+    @property
+    def seconds(self) -> dict[str, float]:
+        """Wall time [s] of its own phases: "fluid" (the fluid steps) and "parcels" (the parcel sub-loops)."""
+
     def advance(self, until: float, sink: ProppantSink) -> None:
         """Step to ``until`` [s], a step landing on it, writing the snapshots due and a balance record a step."""
 
