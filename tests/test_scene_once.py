@@ -50,3 +50,4 @@ def test_check_reads_and_checks_the_scene_once(calls, capsys):
 def test_run_reads_and_checks_the_scene_once(calls, tmp_path):
     assert main(["run", str(TINY), "--out", str(tmp_path / "r.h5"), "--no-progress"]) == 0
     assert dict(calls) == ONCE
+
