@@ -77,13 +77,13 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _run(args: argparse.Namespace) -> None:
-    from .runner import run
+    from .runner import run_validated
     from .scene_checks import print_warnings, validate
 
     scene = validate(args.scene)  # what check reports: errors, then the same warnings
     print_warnings(scene)
     args.out.parent.mkdir(parents=True, exist_ok=True)  # as plot and export create theirs
-    run(scene, args.out, progress=not args.no_progress, rrd=args.rrd, view=args.view,
+    run_validated(scene, args.out, progress=not args.no_progress, rrd=args.rrd, view=args.view,
         connect=args.connect, resume=args.resume, viewer_required=args.viewer_required)
 
 

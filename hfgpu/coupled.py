@@ -43,20 +43,21 @@ annulus, default 1.5 x the larger proppant cell size: the injection cell and its
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import time as _time
 import warnings
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 
 from .coupling import FractureHistory, proppant_frame, screen_out_cells
 from .coupling_config import DEFAULT_INLET_CELLS
+from .engines import FractureEngine, ProppantEngine
 from .errors import SceneError
 from .fracture.mesh import injection_cell_centre
 from .fracture.simulator import FractureRun, simulate as simulate_fracture
-from .fracture.slurry import held_tips
 from .io.progress import shifted
 from .io.sink import FractureSink, ProppantSink, ResultsSink
 from .proppant.config import Geometry, Port
@@ -126,23 +127,45 @@ def proppant_scene(scene: Scene, frame: GridFrame, shape: tuple[int, int], width
         mesh=dataclasses.replace(scene.mesh, dx=frame.dx, dz=frame.dz))
 
 
+def proppant_simulation(scene: Scene, frame: GridFrame, shape: tuple[int, int], start: float,
+                        width_at: Callable[[float], tuple[np.ndarray, np.ndarray]]) -> ProppantSimulation:
+    """The proppant run of the coupled scene from ``start`` (:func:`proppant_scene`; its clock is 0 there) on the
+    grid (frame, shape), its walls ``width_at(t)`` = (width, leak-off rate) at the scene's time t."""
+    sim = ProppantSimulation(proppant_scene(scene, frame, shape, width_at(start)[0], start),
+                             width_field=lambda t: width_at(t + start))
+    sim.watch.offset = start
+    return sim
+
+
 class Timings:
-    """Wall time [s] per phase (time.perf_counter): fracture, fluid (SIMPLE steps), parcels (particle
-    sub-loops), io (sinks), and in a two-way run footprint (the clean-fluid pass) and feedback (the slurry
-    handed to the fracture); the rest of a run (scatter, injection, width resampling, set-up) is not split."""
+    """Wall time [s] per phase of the coupled loop (time.perf_counter): fracture, fluid (SIMPLE steps), parcels
+    (particle sub-loops), io (sinks), and in a two-way run footprint (the clean-fluid pass) and feedback (the
+    slurry handed to the fracture); the rest of a run (scatter, injection, width resampling, set-up) is not split.
+    The loop measures its phases (:meth:`measure`); the proppant run measures its fluid and parcels
+    (``ProppantSimulation.seconds``, added by :meth:`add`)."""
 
     def __init__(self):
         self.seconds = {"fracture": 0.0, "fluid": 0.0, "parcels": 0.0, "io": 0.0}
+        self._inner: list[float] = []  # per open measure: the time of the measures inside it
 
-    def wrap(self, key: str, function: Callable) -> Callable:
-        """``function`` with its wall time added to ``seconds[key]``."""
-        def timed(*args, **kwargs):
-            t0 = _time.perf_counter()
-            try:
-                return function(*args, **kwargs)
-            finally:
-                self.seconds[key] += _time.perf_counter() - t0
-        return timed
+    @contextlib.contextmanager
+    def measure(self, key: str) -> Iterator[None]:
+        """Add the block's wall time to ``seconds[key]``, less that of the measures inside it (the sinks' io
+        within the fracture's steps)."""
+        t0 = _time.perf_counter()
+        self._inner.append(0.0)
+        try:
+            yield
+        finally:
+            elapsed = _time.perf_counter() - t0
+            self.seconds[key] += elapsed - self._inner.pop()
+            if self._inner:
+                self._inner[-1] += elapsed
+
+    def add(self, seconds: dict[str, float]) -> None:
+        """Add phases an engine measured itself."""
+        for key, value in seconds.items():
+            self.seconds[key] += value
 
 
 class _FractureTee:
@@ -152,16 +175,17 @@ class _FractureTee:
     def __init__(self, sink: FractureSink, timings: Timings):
         self.snapshots: list[FractureSnapshot] = []
         self.last: BalanceRecord | None = None
-        self._snap = timings.wrap("io", sink.fracture_snapshot)
-        self._balance = timings.wrap("io", sink.fracture_balance)
+        self.sink, self.timings = sink, timings
 
     def fracture_snapshot(self, snap: FractureSnapshot) -> None:
         self.snapshots.append(snap)
-        self._snap(snap)
+        with self.timings.measure("io"):
+            self.sink.fracture_snapshot(snap)
 
     def fracture_balance(self, record: BalanceRecord) -> None:
         self.last = record
-        self._balance(record)
+        with self.timings.measure("io"):
+            self.sink.fracture_balance(record)
 
 
 class _Snapshots:
@@ -182,8 +206,7 @@ class _ProppantShift:
 
     def __init__(self, sink: ProppantSink, start: float, factor: float, timings: Timings):
         self.start, self.factor = start, factor
-        self._snap = timings.wrap("io", sink.proppant_snapshot)
-        self._balance = timings.wrap("io", sink.proppant_balance)
+        self.sink, self.timings = sink, timings
         self.flagged = 0
         self.flagged_max = 0
         self.first_time = math.nan
@@ -195,10 +218,14 @@ class _ProppantShift:
         self.flagged_max = max(self.flagged_max, self.flagged)
         if self.flagged and math.isnan(self.first_time):
             self.first_time = t
-        self._snap(dataclasses.replace(snap, time=t, grid={**snap.grid, "bridging_risk": risk.astype(np.int8)}))
+        shifted_snap = dataclasses.replace(snap, time=t, grid={**snap.grid, "bridging_risk": risk.astype(np.int8)})
+        with self.timings.measure("io"):
+            self.sink.proppant_snapshot(shifted_snap)
 
     def proppant_balance(self, record: SolidBalanceRecord) -> None:
-        self._balance(dataclasses.replace(record, time=record.time + self.start))
+        shifted_record = dataclasses.replace(record, time=record.time + self.start)
+        with self.timings.measure("io"):
+            self.sink.proppant_balance(shifted_record)
 
     def state(self) -> dict:
         """The screen-out counters (a checkpoint)."""
@@ -256,26 +283,20 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
     cfg = scene.coupling
     tee = _FractureTee(sink, timings)
     fracture_scene = scene.replace(output=dataclasses.replace(scene.output, every=cfg.fracture_every))
-    t0 = _time.perf_counter()
     phase = resume["phase"] if resume is not None else "fracture"
     if resume is not None:
         tee.snapshots = list(resume["fracture_snapshots"])
     if phase == "fracture":
-        fracture = simulate_fracture(fracture_scene, tee, progress, resume=resume and resume["fracture"],
-                                     checkpoint=checkpoint and checkpoint.within(
-                                         0.0, lambda state: {"phase": "fracture", "fracture": state}))
+        with timings.measure("fracture"):
+            fracture = simulate_fracture(fracture_scene, tee, progress, resume=resume and resume["fracture"],
+                                         checkpoint=checkpoint and checkpoint.within(
+                                             0.0, lambda state: {"phase": "fracture", "fracture": state}))
     else:
         fracture = resume["fracture_summary"]
     history = FractureHistory(tee.snapshots)
-    timings.seconds["fracture"] += _time.perf_counter() - t0 - timings.seconds["io"]
     start = late_start(scene, start, float(history.times[0]))
     frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=injection_cell_centre(scene))
-    field = history.width_field(frame, shape, cfg.min_width)
-    sub = proppant_scene(scene, frame, shape, field(start)[0], start)
-    sim = ProppantSimulation(sub, width_field=lambda t: field(t + start))
-    sim.watch.offset = start
-    sim.solver.step = timings.wrap("fluid", sim.solver.step)
-    sim.engine.substeps = timings.wrap("parcels", sim.engine.substeps)
+    sim = proppant_simulation(scene, frame, shape, start, history.width_field(frame, shape, cfg.min_width))
     shift = _ProppantShift(sink, start, scene.proppant.params.bridging_factor, timings)
     if phase == "proppant":
         shift.restore(resume["screen_out"])
@@ -290,6 +311,7 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
     proppant = sim.run(shift, None if progress is None else shifted(progress, start),
                        checkpoint=checkpoint and checkpoint.within(start, wrap),
                        resume=resume["proppant"] if phase == "proppant" else None)
+    timings.add(sim.seconds)
     warn_screen_out(proppant, scene.proppant.params.theta_cp, offset=start)
     warn_inconsistent_width(proppant)
     proppant["screen_out_time"] += start
@@ -325,29 +347,19 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
     timings.seconds.update(footprint=0.0, feedback=0.0)
     cfg, params = scene.coupling, scene.proppant.params
     fracture_scene = scene.replace(output=dataclasses.replace(scene.output, every=cfg.fracture_every))
-    t0 = _time.perf_counter()
-    clean = _Snapshots()
-    simulate_fracture(fracture_scene, clean)
-    history = FractureHistory(clean.snapshots)
-    start = late_start(scene, proppant_start_time(scene), float(history.times[0]))
-    frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=injection_cell_centre(scene))
-    timings.seconds["footprint"] += _time.perf_counter() - t0
+    with timings.measure("footprint"):
+        clean = _Snapshots()
+        simulate_fracture(fracture_scene, clean)
+        history = FractureHistory(clean.snapshots)
+        start = late_start(scene, proppant_start_time(scene), float(history.times[0]))
+        frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=injection_cell_centre(scene))
 
     tee = _FractureTee(sink, timings)
-    run = FractureRun(fracture_scene, tee, progress)
-
-    def advance_fracture(until: float) -> None:
-        t_a, io = _time.perf_counter(), timings.seconds["io"]
-        run.advance(until)
-        timings.seconds["fracture"] += _time.perf_counter() - t_a - (timings.seconds["io"] - io)
-
-    advance_fracture(start)
+    run: FractureEngine = FractureRun(fracture_scene, tee, progress)
+    with timings.measure("fracture"):
+        run.advance(start)
     geometry = {"width": FractureHistory(tee.snapshots).width_field(frame, shape, cfg.min_width)}
-    sim = ProppantSimulation(proppant_scene(scene, frame, shape, geometry["width"](start)[0], start),
-                             width_field=lambda t: geometry["width"](t + start))
-    sim.watch.offset = start
-    sim.solver.step = timings.wrap("fluid", sim.solver.step)
-    sim.engine.substeps = timings.wrap("parcels", sim.engine.substeps)
+    sim: ProppantEngine = proppant_simulation(scene, frame, shape, start, lambda t: geometry["width"](t))
     shift = _ProppantShift(sink, start, params.bridging_factor, timings)
     every = cfg.fracture_every
     ends = [every * k for k in range(int(math.floor(start / every + 1e-9)) + 1,
@@ -355,18 +367,19 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
     ends = sorted({t for t in ends if t > start} | {scene.run.end_time})
     t_screen_out, p_screen_out, p_max = math.nan, math.nan, -math.inf
     for t_next in ends:
-        advance_fracture(t_next)
+        with timings.measure("fracture"):
+            run.advance(t_next)
         geometry["width"] = FractureHistory(tee.snapshots).width_field(frame, shape, cfg.min_width)
         sim.advance(t_next - start, shift)
-        t_a = _time.perf_counter()
-        run.engine.use_slurry(slurry_of(sim.snapshot(), params))
-        timings.seconds["feedback"] += _time.perf_counter() - t_a
+        with timings.measure("feedback"):
+            run.use_slurry(slurry_of(sim.snapshot(), params))
         p_net = tee.last.net_pressure
-        if math.isnan(t_screen_out) and held_tips(run.engine.grid["active"], run.engine.blocked_box):
+        if math.isnan(t_screen_out) and run.tips_held():
             t_screen_out, p_screen_out = t_next, p_net
         if not math.isnan(t_screen_out):
             p_max = max(p_max, p_net)
     proppant = sim.finish(shift)
+    timings.add(sim.seconds)
     warn_screen_out(proppant, params.theta_cp, offset=start)
     warn_inconsistent_width(proppant)
     proppant["screen_out_time"] += start

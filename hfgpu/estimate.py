@@ -183,9 +183,8 @@ def _clusters(scene: Any) -> int:
     return 1 if completion is None else completion.clusters
 
 
-def report(scene: Any, system: str) -> str:
-    """The lines ``hfgpu check`` prints under "expected" ("" when :func:`estimate` has nothing to say)."""
-    e = estimate(scene)
+def report(e: Estimate | None, scene: Any, system: str) -> str:
+    """The lines ``hfgpu check`` prints under "expected" for ``e``, the scene's :func:`estimate` ("" for None)."""
     if e is None:
         return ""
     minutes = format_number(e.pumping_time / 60.0, 3)
@@ -221,9 +220,9 @@ def _basis(e: Estimate) -> str:
     return "Carter leak-off over the area where the fracture stops spreading after shut-in"
 
 
-def warnings(scene: Any, system: str) -> list[str]:
-    """The module docstring's warnings, in the scene's units, naming the key each concerns."""
-    e = estimate(scene)
+def warnings(e: Estimate | None, scene: Any, system: str) -> list[str]:
+    """The module docstring's warnings for ``e``, the scene's :func:`estimate`, in the scene's units, naming the key
+    each concerns."""
     if e is None:
         return []
     found = []

@@ -10,15 +10,9 @@ and costs, with measured numbers: docs/presets.md.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 
 @dataclass(frozen=True)
@@ -78,8 +72,8 @@ KNOBS: tuple[tuple[str, str, str | None], ...] = (
 def effective_knobs(scene: Any) -> list[tuple[str, Any, str]]:
     """(key path, value in use, where it came from: "scene", "preset <name>" or "from the scene: <reason>", a
     default computed from the scene's scales, hfgpu.defaults) of each preset knob the scene's physics reads and
-    of each derived one; the origin is read from the scene's TOML text (``scene.source``)."""
-    data = tomllib.loads(scene.source) if scene.source else {}
+    of each derived one; the origin is read from the scene's parsed TOML text (``scene.document``)."""
+    data = scene.document
     objects = {"mesh": scene.mesh, "fracture": scene.fracture,
                "mppic": scene.proppant.numerics if scene.proppant is not None else None}
     derived = {d.key: d for d in scene.derived}

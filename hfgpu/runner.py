@@ -93,6 +93,15 @@ def run(scene_or_path: Scene | str | Path, out: str | Path, *, progress: bool = 
     scene = validate(scene_or_path)  # as ``hfgpu check``: limits and the engine's start (hfgpu.scene_checks)
     if isinstance(scene_or_path, Scene):  # one read from a file is its text
         warn_edited(scene)
+    return run_validated(scene, out, progress=progress, rrd=rrd, view=view, connect=connect, resume=resume,
+                         viewer_required=viewer_required)
+
+
+def run_validated(scene: Scene, out: str | Path, *, progress: bool = True, rrd: str | Path | None = None,
+                  view: bool = False, connect: str | None = None, resume: bool = False,
+                  viewer_required: bool = False) -> dict[str, Any]:
+    """:func:`run` of a scene :func:`hfgpu.scene_checks.validate` returned, without checking it again (``hfgpu
+    run`` validates the scene once, prints its warnings, then runs it)."""
     blas_thread_limit(0)  # a bad HFGPU_BLAS_THREADS is an error before any work
     simulate = simulator_for(scene)
     view, connect = _reachable_viewers(view, connect, viewer_required)

@@ -20,7 +20,7 @@ import math
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,6 +33,16 @@ from .errors import SceneError
 from .presets import DEFAULT_PRESET, PRESETS, Preset
 from .scene_reader import Table, collecting_warnings, raise_all, scene_system, warn
 from .units import SYSTEMS, convert, display_text, majority_system
+
+if TYPE_CHECKING:  # the sections' own modules, imported at run time only when the scene has the section
+    from .closure.config import ClosureConfig
+    from .completion import Completion
+    from .coupling_config import CouplingConfig
+    from .defaults import Derived
+    from .estimate import Estimate
+    from .fracture.config import FractureNumerics
+    from .proppant.config import ProppantSetup
+    from .wellbore import Wellbore
 
 PHYSICS = ("fracture", "proppant")
 
@@ -246,23 +256,31 @@ class Output:
 
 @dataclass(frozen=True)
 class Scene:
+    """A scene as read: one typed frozen configuration per section (None where the scene has not the section or
+    its physics), the TOML text and what was found while reading and checking it."""
+
     run: RunConfig
     fluid: Fluid
     mesh: Mesh
     output: Output
     rock: Rock | None = None
     injection: Injection | None = None
-    fracture: Any = None  # hfgpu.fracture.config.FractureNumerics when "fracture" in physics
-    proppant: Any = None  # hfgpu.proppant.config.ProppantSetup when "proppant" in physics
-    coupling: Any = None  # hfgpu.coupled.CouplingConfig when physics has both "fracture" and "proppant"
-    closure: Any = None  # hfgpu.closure.config.ClosureConfig when "proppant" in physics
-    wellbore: Any = None  # hfgpu.wellbore.Wellbore when the scene has [wellbore] (with [injection])
-    completion: Any = None  # hfgpu.completion.Completion when the scene has [completion] (with "fracture")
+    fracture: FractureNumerics | None = None  # when "fracture" in physics
+    proppant: ProppantSetup | None = None  # when "proppant" in physics
+    coupling: CouplingConfig | None = None  # when physics has both "fracture" and "proppant"
+    closure: ClosureConfig | None = None  # when "proppant" in physics
+    wellbore: Wellbore | None = None  # when the scene has [wellbore] (with [injection])
+    completion: Completion | None = None  # when the scene has [completion] (with "fracture")
     source: str = field(default="", repr=False, compare=False)  # the TOML text, stored in results
+    #: The TOML text parsed (read-only; {} for a scene built in code): which keys the scene gives.
+    document: dict = field(default_factory=dict, repr=False, compare=False)
     #: One line each: what the scene reader found suspect but valid (bare numbers); hfgpu.scene_checks adds more.
     warnings: tuple[str, ...] = field(default=(), repr=False, compare=False)
     #: The knobs given defaults from the scene's own scales (hfgpu.defaults.Derived: key, value, reason).
-    derived: tuple[Any, ...] = field(default=(), repr=False, compare=False)
+    derived: tuple[Derived, ...] = field(default=(), repr=False, compare=False)
+    #: What hfgpu.estimate expects of the scene, set by hfgpu.scene_checks.validate; None before it or when there
+    #: is nothing to expect.
+    expected: Estimate | None = field(default=None, repr=False, compare=False)
 
     def has(self, physics: str) -> bool:
         return physics in self.run.physics
@@ -312,7 +330,7 @@ def parse_scene(data: dict, source: str = "") -> Scene:
     ``[rock]``; ``[coupling]`` needs ``[run]`` and ``[mesh]``) is skipped, so that one mistake is reported once. The
     warnings found while reading (bare numbers, :mod:`hfgpu.scene_reader`; gaps between layers; high proppant
     concentrations) are in ``Scene.warnings``. Bare numbers are judged by the scene's unit system
-    (:func:`unit_system`).
+    (:func:`unit_system`). ``data`` is kept as ``Scene.document`` (not copied: the caller hands it over).
     """
     with collecting_warnings(unit_system(data)) as found:
         scene = _parse(data, source)
@@ -441,7 +459,7 @@ def _parse(data: dict, source: str) -> Scene:
 
     scene = Scene(run=run, fluid=fluid, mesh=mesh, output=output, rock=rock, injection=injection,
                   fracture=fracture, proppant=proppant, coupling=coupling, closure=closure, wellbore=wellbore,
-                  completion=completion, source=source)
+                  completion=completion, source=source, document=data)
     return derive(scene, data, preset)[0]
 
 

@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import TextIO
 
 from .errors import SceneError
+from .estimate import Estimate, estimate
 from .estimate import report as expected_report
 from .estimate import warnings as expected_warnings
 from .scene import Scene, load_scene
@@ -58,7 +59,9 @@ def validate(scene_or_path: Scene | str | Path) -> Scene:
         except SceneError as exc:
             errors.append(exc)
     raise_all(errors)
-    return scene.replace(warnings=tuple(dict.fromkeys(scene.warnings + tuple(review(scene)))))
+    expected = estimate(scene)
+    return scene.replace(warnings=tuple(dict.fromkeys(scene.warnings + tuple(review(scene, expected)))),
+                         expected=expected)
 
 
 def print_warnings(scene: Scene, file: TextIO | None = None) -> None:
@@ -68,8 +71,9 @@ def print_warnings(scene: Scene, file: TextIO | None = None) -> None:
         print(f"hfgpu: warning: {' '.join(line.splitlines())}", file=out, flush=True)
 
 
-def review(scene: Scene) -> list[str]:
-    """The warnings of the module docstring, in that order, in the scene's output units."""
+def review(scene: Scene, expected: Estimate | None) -> list[str]:
+    """The warnings of the module docstring, in that order, in the scene's output units (``expected``: what
+    :func:`hfgpu.estimate.estimate` expects of the scene)."""
     system = scene.output.units
     found: list[str] = []
     found += _preset_coarsens(scene, system)
@@ -80,14 +84,14 @@ def review(scene: Scene) -> list[str]:
         found += _schedule(scene, system)
     if scene.rock is not None and scene.rock.layers and scene.injection is not None and scene.has("fracture"):
         found += _layers(scene, system)
-    found += expected_warnings(scene, system)
+    found += expected_warnings(expected, scene, system)
     return found
 
 
 def _preset_coarsens(scene: Scene, system: str) -> list[str]:
     refinement = scene.mesh.refinement
-    mesh = _document(scene).get("mesh")
-    if refinement >= 1.0 or not scene.source or (isinstance(mesh, dict) and "refinement" in mesh):
+    mesh = scene.document.get("mesh")
+    if refinement >= 1.0 or not scene.document or (isinstance(mesh, dict) and "refinement" in mesh):
         return []
     dx, dz = scene.mesh.scene_cell_size
     given = display_text(dx, 'length', system) if dx == dz else \
@@ -175,21 +179,11 @@ def _off_face(scene: Scene, system: str, ordered: list) -> list[str]:
     return found
 
 
-def _document(scene: Scene) -> dict:
-    """The scene's parsed TOML text ({} without one)."""
-    import tomllib
-
-    try:
-        return tomllib.loads(scene.source) if scene.source else {}
-    except tomllib.TOMLDecodeError:
-        return {}
-
-
 def units_note(scene: Scene) -> str:
     """Why the output units are what they are: "[output] units" or the counts of the majority rule."""
     from .units import count_systems
 
-    data = _document(scene)
+    data = scene.document
     output = data.get("output")
     if isinstance(output, dict) and "units" in output:
         return f"units {scene.output.units} ([output] units)"
@@ -202,14 +196,14 @@ def coupling_line(scene: Scene) -> str:
     """Which coupling a coupled scene runs: ``[coupling] mode`` as given, or the default and that it is one."""
     from .coupling_config import DEFAULT_MODE
 
-    given = _document(scene).get("coupling")
+    given = scene.document.get("coupling")
     if isinstance(given, dict) and "mode" in given:
         return f"coupling: {scene.coupling.mode} ([coupling] mode)"
     return f"coupling: {DEFAULT_MODE} (the default; set [coupling] mode = \"one-way\" or \"two-way\" to choose)"
 
 
 def describe(scene: Scene, name: str) -> str:
-    """The lines ``hfgpu check`` prints on stdout for a valid scene, in its output units."""
+    """The lines ``hfgpu check`` prints on stdout for a scene :func:`validate` returned, in its output units."""
     from .io.summary import schedule_table
     from .presets import knob_report
 
@@ -223,7 +217,7 @@ def describe(scene: Scene, name: str) -> str:
         lines.append(coupling_line(scene))
     if scene.injection is not None:
         lines.append(schedule_table(scene, system))
-    expected = expected_report(scene, system)
+    expected = expected_report(scene.expected, scene, system)
     if expected:
         lines.append(expected)
     return "\n".join(lines)

@@ -46,6 +46,24 @@ def test_one_file_holds_fracture_and_proppant(tiny):
     assert r.summary["proppant_nx"] == summary["proppant_nx"]
 
 
+def test_the_phases_are_timed(tiny, monkeypatch):
+    """Each phase's wall time is in the summary (the proppant run measures its fluid steps and parcel sub-loops);
+    a measure inside another is taken out of it (the sinks' io out of the fracture's steps)."""
+    import time
+
+    from hfgpu.coupled import Timings
+
+    summary, _ = tiny
+    assert all(summary[f"time_{phase}"] > 0.0 for phase in ("fracture", "fluid", "parcels", "io"))
+    clock = iter([0.0, 1.0, 3.0, 6.0])
+    monkeypatch.setattr(time, "perf_counter", lambda: next(clock))
+    timings = Timings()
+    with timings.measure("fracture"):
+        with timings.measure("io"):
+            pass
+    assert timings.seconds["io"] == 2.0 and timings.seconds["fracture"] == 4.0
+
+
 def test_solid_balance_and_scheduled_solid(tiny):
     _, r = tiny
     b = r.proppant_balance

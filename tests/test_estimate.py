@@ -49,7 +49,7 @@ def test_the_estimate_is_the_radial_solution_of_the_mean_rate_in_the_perforated_
 @pytest.mark.parametrize("path", sorted(SCENES.glob("corpus_*.toml")), ids=lambda p: p.stem)
 def test_the_corpus_treatments_get_none_of_these_warnings(path):
     scene = validate(path)
-    assert warnings(scene, scene.output.units) == []
+    assert warnings(scene.expected, scene, scene.output.units) == []
 
 
 def test_a_grain_larger_than_the_opening_is_warned_with_its_key():

@@ -182,3 +182,25 @@ def test_a_long_bad_value_is_shortened_in_the_message():
     message = str(caught.value)
     assert "'rock.youngs_modulus'" in message and f"got '{'x' * 28}..." in message and len(message) < 200
     assert caught.value.value == long
+
+
+def test_scene_slots_are_typed_with_the_sections_configs():
+    """Each section slot of Scene names its section's frozen dataclass (imported for type checking only, so that
+    a scene loads no physics it does not ask for)."""
+    import typing
+
+    from hfgpu.closure.config import ClosureConfig
+    from hfgpu.completion import Completion
+    from hfgpu.coupling_config import CouplingConfig
+    from hfgpu.defaults import Derived
+    from hfgpu.estimate import Estimate
+    from hfgpu.fracture.config import FractureNumerics
+    from hfgpu.proppant.config import ProppantSetup
+    from hfgpu.scene import Scene
+    from hfgpu.wellbore import Wellbore
+
+    types = {"fracture": FractureNumerics, "proppant": ProppantSetup, "coupling": CouplingConfig,
+             "closure": ClosureConfig, "wellbore": Wellbore, "completion": Completion, "expected": Estimate}
+    hints = typing.get_type_hints(Scene, localns={t.__name__: t for t in (*types.values(), Derived)})
+    assert {name: hints[name] for name in types} == {name: t | None for name, t in types.items()}
+    assert hints["derived"] == tuple[Derived, ...]

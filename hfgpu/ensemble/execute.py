@@ -46,11 +46,10 @@ def run_member(scene_text: str, path: str, names: list[str]) -> tuple[str, dict[
     """The task: run one member into its results file; (status, metrics, wall seconds). A failed run is
     returned as "failed: <message>"; OSError and MemoryError are raised for Dask to retry."""
     from ..runner import run
-    from ..scene import load_scene
 
     start = time.perf_counter()
     try:
-        run(load_scene(scene_text), path, progress=False)
+        run(scene_text, path, progress=False)  # the text: read once (a Scene would be read again, warn_edited)
     except (OSError, MemoryError):
         raise
     except Exception as exc:  # any failure of the run itself is the member's result

@@ -95,7 +95,7 @@ from .leakoff import carter_demand, carter_volume
 from .lubrication import build_faces
 from .mesh import GROW, Grid, injection_cell_centre
 from .newton import drained_start, Elasticity, NewtonWork, StepProblem, StepResult, solve_step, start_widths
-from .slurry import Slurry
+from .slurry import Slurry, held_tips
 from .solver_choice import use_dense
 from .views import View, front_extents, geometry, snapshot
 
@@ -498,10 +498,10 @@ def _landed(output: float, t: float) -> bool:
 
 
 class FractureRun:
-    """One run of the engine driven to a time: ``advance(until)`` steps it there (landing a step on it), so a
-    caller can hand it a slurry between calls (``engine.use_slurry``, the two-way coupled loop of
-    hfgpu.coupled); :func:`simulate` advances it to the end at once. Arguments as :func:`simulate`'s, plus the
-    ``slurry`` it starts in (fracture/slurry.py; None: clean fluid)."""
+    """One run of the engine driven to a time (a :class:`hfgpu.engines.FractureEngine`): ``advance(until)`` steps
+    it there (landing a step on it), so a caller can hand it a slurry between calls (``use_slurry``, the two-way
+    coupled loop of hfgpu.coupled); :func:`simulate` advances it to the end at once. Arguments as
+    :func:`simulate`'s, plus the ``slurry`` it starts in (fracture/slurry.py; None: clean fluid)."""
 
     def __init__(self, scene, sink, progress: Callable[[float], None] | None = None, checkpoint=None,
                  resume: dict | None = None, slurry: Slurry | None = None):
@@ -516,6 +516,19 @@ class FractureRun:
             eng.restore(resume["engine"])
             self.dt, self.index = resume["dt"], int(resume["target"])
         self.k = sum(1 for t in self.outputs if t < eng.t or _landed(t, eng.t)) if resume is not None else 0
+
+    @property
+    def time(self) -> float:
+        """The engine's clock [s]: the time its last step reached (its start time before the first)."""
+        return self.engine.t
+
+    def use_slurry(self, slurry: Slurry) -> None:
+        """Step on in the slurry's fields (:meth:`_Engine.use_slurry`)."""
+        self.engine.use_slurry(slurry)
+
+    def tips_held(self) -> int:
+        """Cells where the slurry holds the front's lateral tip now (:func:`hfgpu.fracture.slurry.held_tips`)."""
+        return held_tips(self.engine.grid["active"], self.engine.blocked_box)
 
     def advance(self, until: float) -> None:
         """Step to ``until`` (or the end), writing records and snapshots (:func:`simulate`)."""

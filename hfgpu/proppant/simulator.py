@@ -50,6 +50,7 @@ import json
 import math
 import warnings
 from dataclasses import dataclass
+from time import perf_counter
 from typing import Callable
 
 import numpy as np
@@ -138,14 +139,16 @@ class StepInfo:
 
 
 class ProppantSimulation:
-    """State and stepping of one MP-PIC run; :func:`simulate` drives it to the end time.
+    """State and stepping of one MP-PIC run (a :class:`hfgpu.engines.ProppantEngine`); :func:`simulate` drives it
+    to the end time.
 
     Attributes a caller may read: ``time``, ``grid``, ``parcels`` (:class:`Parcels`), ``fluid`` (the fluid
     solver's state), ``injected``, ``outflow``, ``screened_out`` [m^3] (solids), ``screen_out_time`` [s] (first
     hold-back, NaN when none), ``fluid_totals`` (the fluid volumes of FLUID_VOLUMES summed over the steps;
     injected + opened + supplied = stored + leaked + outflow; ``supplied``: what a width history
-    inconsistent with the injection needed beyond it, hfgpu.proppant.fluid.StepInfo). ``add_parcels`` places
-    extra parcels (counted as injected), e.g. a single test particle.
+    inconsistent with the injection needed beyond it, hfgpu.proppant.fluid.StepInfo), ``seconds`` (wall time [s]
+    of the fluid steps, "fluid", and of the parcel sub-loops, "parcels", retries included). ``add_parcels``
+    places extra parcels (counted as injected), e.g. a single test particle.
     """
 
     def __init__(self, scene, width_field: WidthField | None = None):
@@ -169,6 +172,7 @@ class ProppantSimulation:
                                                   self.mu_f, self.numerics.gravity, self.outlets,
                                                   arch=self.numerics.arch)
         self.time = 0.0
+        self.seconds = {"fluid": 0.0, "parcels": 0.0}
         self.rng = np.random.default_rng(scene.run.seed)
         open_volume = self.grid.cell_volume[self.grid.active]
         schedule = scene.injection.schedule if scene.injection is not None else None
@@ -279,19 +283,24 @@ class ProppantSimulation:
             self.engine.begin_step(self.fluid.u, self.fluid.v, self.fluid.p)
             if self.injector is not None:
                 self._inject(t0, t0 + dt)
+            t_a = perf_counter()
             loop = self.engine.substeps(dt, self.numerics.particle_substeps, t0)
+            self.seconds["parcels"] += perf_counter() - t_a
             self.moments = self.engine.moments()
             sources, momentum = ((self.injector.fluid_sources(t0, t0 + dt), self.injector.jet_momentum(t0, t0 + dt))
                                  if self.injector is not None else (np.zeros(self.grid.shape), (None, None)))
             trial = self.solver.copy_state(self.fluid)
+            theta_p, t_a = self._fluid_theta_p(), perf_counter()
             try:
-                info = self.solver.step(trial, dt, self._fluid_theta_p(), loop.force_x, loop.force_z,
+                info = self.solver.step(trial, dt, theta_p, loop.force_x, loop.force_z,
                                         sources=sources, leakoff=self.leakoff, outlets=self.outlets,
                                         drag_x=loop.beta_x, drag_z=loop.beta_z, momentum_x=momentum[0],
                                         momentum_z=momentum[1])
             except CourantLimitExceeded as exc:
                 dt = min(0.5 * dt, exc.stable_dt)
                 continue
+            finally:
+                self.seconds["fluid"] += perf_counter() - t_a
             if info.courant <= self.numerics.c_max:
                 break
             dt *= min(0.5, 0.9 * self.numerics.c_max / info.courant)
