@@ -58,6 +58,27 @@ def offset_influence(offset_x, offset_z, offset_y: float, dx: float, dz: float,
     return plane_strain_modulus / (8.0 * np.pi) * bracket
 
 
+def _box(cell_sets) -> tuple[int, int, int, int]:
+    """(ix0, iz0, nx, nz): the bounding box of the (ix, iz) index arrays of ``cell_sets`` (none empty)."""
+    ix0 = min(int(np.min(c[0])) for c in cell_sets)
+    iz0 = min(int(np.min(c[1])) for c in cell_sets)
+    return (ix0, iz0, max(int(np.max(c[0])) for c in cell_sets) - ix0 + 1,
+            max(int(np.max(c[1])) for c in cell_sets) - iz0 + 1)
+
+
+def _fft_shape(nx: int, nz: int) -> tuple[int, int]:
+    """The zero-padded real FFT grid (z, x) of a linear (not circular) convolution on an nx x nz box."""
+    return scipy.fft.next_fast_len(2 * nz - 1, real=True), scipy.fft.next_fast_len(2 * nx - 1, real=True)
+
+
+def _transform(cells: tuple[np.ndarray, np.ndarray], w: np.ndarray, box: tuple[int, int, int, int],
+               shape: tuple[int, int]) -> np.ndarray:
+    """rfft2 of the openings ``w`` placed at ``cells`` = (ix, iz) of ``box`` on the FFT grid ``shape``."""
+    grid = np.zeros(shape)
+    grid[np.asarray(cells[1]) - box[1], np.asarray(cells[0]) - box[0]] = w
+    return scipy.fft.rfft2(grid)
+
+
 class PlanesOperator:
     """The elasticity of N parallel fracture planes on one in-plane grid (cells dx x dz; plane k at normal
     position ``positions[k]`` [m]): the normal stress on every active cell of every plane from the openings of
@@ -96,22 +117,19 @@ class PlanesOperator:
         every = [c for c in cells if len(c[0])]
         if not every:
             return [np.zeros(0) for _ in cells]
-        ix0 = min(int(np.min(c[0])) for c in every)
-        iz0 = min(int(np.min(c[1])) for c in every)
-        nx = max(int(np.max(c[0])) for c in every) - ix0 + 1
-        nz = max(int(np.max(c[1])) for c in every) - iz0 + 1
-        shape = (scipy.fft.next_fast_len(2 * nz - 1, real=True), scipy.fft.next_fast_len(2 * nx - 1, real=True))
-        hats = []
-        for (ix, iz), wk in zip(cells, w):
-            grid = np.zeros(shape)
-            grid[np.asarray(iz) - iz0, np.asarray(ix) - ix0] = wk
-            hats.append(scipy.fft.rfft2(grid))
-        out = []
-        for k, (ix, iz) in enumerate(cells):
-            total = sum(hats[m] * self._table_hat(abs(float(self.positions[k] - self.positions[m])), shape)
-                        for m in range(len(cells)))
-            out.append(scipy.fft.irfft2(total, s=shape)[np.asarray(iz) - iz0, np.asarray(ix) - ix0])
-        return out
+        box = _box(every)
+        shape = _fft_shape(box[2], box[3])
+        hats = [_transform(c, wk, box, shape) for c, wk in zip(cells, w)]
+        return [self._received(k, range(len(cells)), hats, shape)[np.asarray(iz) - box[1], np.asarray(ix) - box[0]]
+                for k, (ix, iz) in enumerate(cells)]
+
+    def _received(self, k: int, sources, hats: list[np.ndarray], shape: tuple[int, int]) -> np.ndarray:
+        """The stress on plane k's FFT grid from the planes ``sources`` (indices into ``hats``, their
+        transforms): the inverse FFT of sum_m hat_m C^(k <- m) (zero without sources)."""
+        total = np.zeros((shape[0], shape[1] // 2 + 1), dtype=complex)
+        for m in sources:
+            total += hats[m] * self._table_hat(abs(float(self.positions[k] - self.positions[m])), shape)
+        return scipy.fft.irfft2(total, s=shape)
 
     def on_plane(self, k: int, receivers: tuple[np.ndarray, np.ndarray], cells: list[tuple[np.ndarray, np.ndarray]],
                  w: list[np.ndarray]) -> np.ndarray:
@@ -122,39 +140,20 @@ class PlanesOperator:
         ix, iz = np.asarray(receivers[0]), np.asarray(receivers[1])
         if not others or ix.size == 0:
             return np.zeros(ix.size)
-        every = [cells[m] for m in others] + [(ix, iz)]
-        ix0, iz0 = min(int(np.min(c[0])) for c in every), min(int(np.min(c[1])) for c in every)
-        nx = max(int(np.max(c[0])) for c in every) - ix0 + 1
-        nz = max(int(np.max(c[1])) for c in every) - iz0 + 1
-        shape = (scipy.fft.next_fast_len(2 * nz - 1, real=True), scipy.fft.next_fast_len(2 * nx - 1, real=True))
-        total = 0.0
-        for m in others:
-            grid = np.zeros(shape)
-            grid[np.asarray(cells[m][1]) - iz0, np.asarray(cells[m][0]) - ix0] = w[m]
-            spacing = abs(float(self.positions[k] - self.positions[m]))
-            total = total + scipy.fft.rfft2(grid) * self._table_hat(spacing, shape)
-        return scipy.fft.irfft2(total, s=shape)[iz - iz0, ix - ix0]
+        box = _box([cells[m] for m in others] + [(ix, iz)])
+        shape = _fft_shape(box[2], box[3])
+        hats = {m: _transform(cells[m], w[m], box, shape) for m in others}
+        return self._received(k, others, hats, shape)[iz - box[1], ix - box[0]]
 
     def shadow_fields(self, box: tuple[int, int, int, int], cells: list[tuple[np.ndarray, np.ndarray]],
                       w: list[np.ndarray]) -> list[np.ndarray]:
         """[sum_{l != k} C(k <- l) w_l at every cell of ``box`` for each plane k]: the shadow the other planes cast
         on the whole box (ix0, iz0, nx, nz) of the shared grid, which holds every plane's ``cells``; (nz, nx) arrays,
         by N forward FFTs, N (N - 1) spectral products and N inverse FFTs, O(N^2 M + N M log M)."""
-        ix0, iz0, nx, nz = box
-        shape = (scipy.fft.next_fast_len(2 * nz - 1, real=True), scipy.fft.next_fast_len(2 * nx - 1, real=True))
-        hats = []
-        for (ix, iz), wk in zip(cells, w):
-            grid = np.zeros(shape)
-            grid[np.asarray(iz) - iz0, np.asarray(ix) - ix0] = wk
-            hats.append(scipy.fft.rfft2(grid))
-        out = []
-        for k in range(len(cells)):
-            total = np.zeros_like(hats[0])
-            for m in range(len(cells)):
-                if m != k:
-                    total += hats[m] * self._table_hat(abs(float(self.positions[k] - self.positions[m])), shape)
-            out.append(scipy.fft.irfft2(total, s=shape)[:nz, :nx])
-        return out
+        shape = _fft_shape(box[2], box[3])
+        hats = [_transform(c, wk, box, shape) for c, wk in zip(cells, w)]
+        return [self._received(k, [m for m in range(len(cells)) if m != k], hats, shape)[:box[3], :box[2]]
+                for k in range(len(cells))]
 
     def dense(self, cells: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
         """The block matrix [C(k <- l)] over all planes' active cells, in the order of ``cells``, from

@@ -230,19 +230,21 @@ def gather(parcels: Parcels, frame: GridFrame, fields: GridFields) -> ParcelFlui
         fluid_u=interpolate(fields.fluid_u, kxu, ixu, wxu), fluid_v=interpolate(fields.fluid_v, kzv, izv, wzv),
         dpdx=free * interpolate(fields.dpdx, kx, ix, wx), dpdz=free * interpolate(fields.dpdz, kz, iz, wz),
         dtaudx=interpolate(fields.dtaudx, kx, ix, wx), dtaudz=interpolate(fields.dtaudz, kz, iz, wz),
-        volume_fraction=seen_fraction(parcels, frame, fields, interpolate(fields.volume_fraction, kc, ic, wc)),
+        volume_fraction=seen_fraction(parcels, frame, fields, interpolate(fields.volume_fraction, kc, ic, wc),
+                                      (ko, io, inside)),
         mean_u=interpolate(fields.mean_u, kc, ic, wc), mean_v=interpolate(fields.mean_v, kc, ic, wc),
         damping_rate=interpolate(fields.damping_rate, kc, ic, wc),
         width=np.where(inside, fields.width[ko, io], 0.0))
 
 
-def seen_fraction(parcels: Parcels, frame: GridFrame, fields: GridFields, dual: np.ndarray) -> np.ndarray:
+def seen_fraction(parcels: Parcels, frame: GridFrame, fields: GridFields, dual: np.ndarray,
+                  owner: tuple[np.ndarray, np.ndarray, np.ndarray]) -> np.ndarray:
     """The volume fraction the parcels see by ``fields.averaging`` (hfgpu.kernels.closures.averaging): ``dual``
     (the bilinear read of the cells' theta_p) for "dual", else from the own cell's S, S_x, S_z (0 outside the
-    grid)."""
+    grid); ``owner``: the parcels' owning_cell."""
     if fields.averaging == "dual":
         return dual
-    ko, io, inside = owning_cell(parcels.x, parcels.z, frame, fields.width.shape)
+    ko, io, inside = owner
     value = averaging.own_cell_fraction_numpy(
         fields.own_volume[ko, io], fields.own_volume_x[ko, io], fields.own_volume_z[ko, io],
         (parcels.x - frame.x0) / frame.dx - io, (parcels.z - frame.z0) / frame.dz - ko,
