@@ -199,6 +199,8 @@ def _write_closure(writer: Any, scene: Scene) -> dict[str, Any]:
     try:
         closure = closure_of(results, scene)
         writer.write_closure(closure.frame, closure.fields, {**closure.scalars, **closure.labels})
+        if closure.clusters:
+            writer.add_summary(closure.cluster_summary())
     except Exception as exc:  # the run itself is complete and kept; closure is post-processing of it
         print(f"hfgpu run: closure not computed: {' '.join(str(exc).splitlines()) or type(exc).__name__}",
               file=sys.stderr, flush=True)

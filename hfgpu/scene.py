@@ -449,6 +449,9 @@ def _parse(data: dict, source: str) -> Scene:
             coupling = sections(("coupling",), lambda: parse_coupling(
                 top.table("coupling", {}), run.end_time, mesh.refinement,
                 fracture.front_tracking if fracture is not None else None))
+        if completion is not None and coupling is not None and coupling.mode == "two-way":
+            sections.errors.append(SceneError("coupling.mode", coupling.mode, 'a stage of clusters ([completion]) '
+                                              'runs one-way only: set "one-way" or leave mode out'))
     elif top.has("coupling"):
         top.raw("coupling")
         sections.errors.append(SceneError("coupling", "(table)",
@@ -465,15 +468,14 @@ def _parse(data: dict, source: str) -> Scene:
 
 def _completion(top: Table, sections: _Sections, physics: tuple[str, ...], injection: Injection | None,
                 rock: Rock | None, mesh: Mesh | None):
-    """``[completion]`` (hfgpu.completion) when the scene has it: it needs run.physics = ["fracture"] (the proppant
-    of a stage is not run in this version), [injection], [rock] and [mesh], and no ``mesh.max_cells_across`` with
-    several clusters (the planes share one grid, which is not coarsened)."""
+    """``[completion]`` (hfgpu.completion) when the scene has it: it needs "fracture" in run.physics ("proppant"
+    beside it runs each cluster's proppant, hfgpu.coupled_stage), [injection], [rock] and [mesh], and no
+    ``mesh.max_cells_across`` with several clusters (the planes share one grid, which is not coarsened)."""
     if not top.has("completion"):
         return None
-    if physics != ("fracture",):
+    if "fracture" not in physics:
         top.raw("completion")
-        sections.errors.append(SceneError("completion", "(table)", 'this section needs run.physics = ["fracture"] '
-                                          "(the proppant of a stage is not run in this version)"))
+        sections.errors.append(SceneError("completion", "(table)", 'this section needs "fracture" in run.physics'))
         return None
     if injection is None or rock is None or mesh is None:
         sections.skip("completion")

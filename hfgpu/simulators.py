@@ -13,14 +13,14 @@ SIMULATORS = {("fracture",): "hfgpu.fracture.simulator", ("proppant",): "hfgpu.p
               ("fracture", "proppant"): "hfgpu.coupled"}
 
 
-#: The module that runs a fracture scene with ``[completion]`` (a stage of N planes, N >= 1).
-STAGE_SIMULATOR = "hfgpu.fracture.stage"
+#: The modules that run a scene with ``[completion]`` (a stage of N planes, N >= 1), per physics set.
+STAGE_SIMULATORS = {("fracture",): "hfgpu.fracture.stage", ("fracture", "proppant"): "hfgpu.coupled_stage"}
 
 
 def simulator_module(scene: Any) -> str:
-    """The module of :data:`SIMULATORS` that runs ``scene``; :data:`STAGE_SIMULATOR` with ``[completion]``."""
+    """The module of :data:`SIMULATORS` that runs ``scene``; of :data:`STAGE_SIMULATORS` with ``[completion]``."""
     if getattr(scene, "completion", None) is not None:
-        return STAGE_SIMULATOR
+        return STAGE_SIMULATORS[tuple(scene.run.physics)]
     return SIMULATORS[tuple(scene.run.physics)]
 
 

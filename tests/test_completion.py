@@ -143,16 +143,15 @@ def test_several_clusters_are_refused_with_a_coarsened_grid():
     assert error.value.path == "mesh.max_cells_across"
 
 
-def test_a_stage_needs_fracture_alone():
-    text = FIELD_SCENE.replace('[run]\nend_time = "600 s"',
-                               '[run]\nend_time = "600 s"\nphysics = ["fracture", "proppant"]')
+def test_a_stage_needs_the_fracture():
+    text = FIELD_SCENE.replace('[run]\nend_time = "600 s"', '[run]\nend_time = "600 s"\nphysics = ["proppant"]')
     with pytest.raises(SceneError) as error:
         load_scene(text + '[completion]\nclusters = 2\nspacing = "60 ft"\n')
     assert any(e.path == "completion" and "physics" in e.allowed for e in getattr(error.value, "errors", [error.value]))
 
 
 def test_a_completion_runs_the_stage():
-    from hfgpu.simulators import STAGE_SIMULATOR, simulator_module
+    from hfgpu.simulators import simulator_module
 
-    assert simulator_module(completion("clusters = 1\n")) == STAGE_SIMULATOR
+    assert simulator_module(completion("clusters = 1\n")) == "hfgpu.fracture.stage"
     assert simulator_module(load_scene(FIELD_SCENE)) == "hfgpu.fracture.simulator"

@@ -21,6 +21,7 @@ dimensionless fracture conductivity (Cinco-Ley & Samaniego 1981) for the formati
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -29,6 +30,7 @@ import numpy as np
 
 from ..errors import HfgpuError
 from ..records import GridFrame, ProppantSnapshot
+from ..stage_blocks import cluster_view, clusters_of
 from .config import ClosureConfig
 from .pack import Pack, propped_width, settle
 from .permeability import kozeny_carman, table_permeability
@@ -36,6 +38,8 @@ from .permeability import kozeny_carman, table_permeability
 #: The scalar attributes of ``/closure`` and their SI units.
 SCALARS = {"time": "s", "propped_area": "m^2", "propped_half_length": "m", "propped_height": "m",
            "mean_conductivity": "m^3", "fcd": "1", "pack_solid_fraction": "1", "formation_permeability": "m^2"}
+#: The scalars given per cluster of a stage (``cluster_<i>_closure_<name>`` in ``/summary``).
+CLUSTER_SCALARS = ("propped_area", "propped_half_length", "propped_height", "mean_conductivity", "fcd")
 
 
 @dataclass(frozen=True)
@@ -49,10 +53,16 @@ class ClosureMap:
     fields: dict[str, np.ndarray] = field(repr=False)
     scalars: dict[str, float]
     labels: dict[str, str]
+    clusters: tuple[dict[str, float], ...] = ()
 
     def summary(self) -> dict[str, Any]:
-        """The scalars and labels prefixed ``closure_`` (for ``/summary``)."""
-        return {f"closure_{k}": v for k, v in {**self.scalars, **self.labels}.items()}
+        """The scalars and labels prefixed ``closure_`` (for ``/summary``), and a stage's :meth:`cluster_summary`."""
+        return {**{f"closure_{k}": v for k, v in {**self.scalars, **self.labels}.items()}, **self.cluster_summary()}
+
+    def cluster_summary(self) -> dict[str, float]:
+        """A stage's per-cluster scalars as ``cluster_<i>_closure_<name>`` (CLUSTER_SCALARS; none for one
+        fracture)."""
+        return {f"cluster_{i}_closure_{k}": c[k] for i, c in enumerate(self.clusters) for k in CLUSTER_SCALARS}
 
 
 def closure_stress(scene: Any, frame: GridFrame, shape: tuple[int, int]) -> np.ndarray:
@@ -93,7 +103,23 @@ def permeability(pack: Pack, classes: tuple, stress: np.ndarray, pack_fraction: 
 
 
 def close(snap: ProppantSnapshot, scene: Any) -> ClosureMap:
-    """The :class:`ClosureMap` of proppant snapshot ``snap`` for ``scene`` (with its ``closure`` config)."""
+    """The :class:`ClosureMap` of proppant snapshot ``snap`` for ``scene`` (with its ``closure`` config). A stage's
+    snapshot (its clusters side by side, hfgpu.stage_blocks) is closed whole and cluster by cluster: the map and
+    ``propped_area`` and ``mean_conductivity`` are the stage's; ``propped_half_length``, ``propped_height`` and
+    ``fcd`` those of the cluster with the largest propped area (a half-length over clusters side by side means
+    nothing); ``clusters`` holds every cluster's scalars."""
+    n = clusters_of(snap)
+    if not n:
+        return _close(snap, scene)
+    whole = _close(snap, scene)
+    parts = [_close(cluster_view(snap, i), scene).scalars for i in range(n)]
+    lead = max(parts, key=lambda c: c["propped_area"])
+    scalars = {**whole.scalars, **{k: lead[k] for k in ("propped_half_length", "propped_height", "fcd")}}
+    return dataclasses.replace(whole, scalars=scalars, clusters=tuple(parts))
+
+
+def _close(snap: ProppantSnapshot, scene: Any) -> ClosureMap:
+    """:func:`close` of one fracture's snapshot."""
     cfg: ClosureConfig = scene.closure
     classes = scene.proppant.classes
     frame, width = snap.frame, np.asarray(snap.grid["width"], dtype=np.float64)

@@ -13,7 +13,9 @@ physics lacks it, e.g. proppant metrics of a fracture-only scene):
 * ``efficiency`` [-]: the summary's fluid efficiency, stored / injected volume;
 * ``screened_out`` [-]: 1 when proppant was held back at the inlets (``proppant_screened_out`` > 0), else 0;
 * ``cluster_area_uniformity`` [-]: a stage of several clusters (``[completion]``): the smallest cluster's created
-  area over the clusters' mean (the summary's ``cluster_<i>_area``; 1: every cluster alike), NaN for one fracture.
+  area over the clusters' mean (the summary's ``cluster_<i>_area``; 1: every cluster alike), NaN for one fracture;
+* ``cluster_propped_uniformity`` [-]: the same of the clusters' propped areas after closure (the summary's
+  ``cluster_<i>_closure_propped_area``, a stage with proppant: hfgpu.coupled_stage), NaN without them.
 
 ``propped_map`` gives the member's cells propped after closure (``/closure`` ``propped``, the cells the
 ``propped_area`` counts) for the ensemble's probability maps.
@@ -29,7 +31,7 @@ NAN = float("nan")
 #: The unit of each metric (SI; "-" for a ratio or a flag).
 UNITS = {"created_area": "m^2", "propped_area": "m^2", "propped_area_in_place": "m^2", "propped_fraction": "-",
          "fracture_height": "m", "fracture_length": "m", "net_pressure_end": "Pa", "efficiency": "-",
-         "screened_out": "-", "cluster_area_uniformity": "-"}
+         "screened_out": "-", "cluster_area_uniformity": "-", "cluster_propped_uniformity": "-"}
 
 
 def member_metrics(results) -> dict[str, float]:
@@ -42,12 +44,14 @@ def member_metrics(results) -> dict[str, float]:
     out = {"created_area": fracture("area"), "fracture_height": fracture("height"),
            "fracture_length": fracture("length"), "efficiency": float(s.get("efficiency", NAN)),
            "net_pressure_end": float(s.get("net_pressure_end", NAN)), "propped_area": NAN, "propped_fraction": NAN,
-           "propped_area_in_place": NAN, "screened_out": NAN, "cluster_area_uniformity": NAN}
-    clusters: list[float] = []
-    while f"cluster_{len(clusters)}_area" in s:
-        clusters.append(float(s[f"cluster_{len(clusters)}_area"]))
-    if len(clusters) > 1:
-        out["cluster_area_uniformity"] = min(clusters) / float(np.mean(clusters))
+           "propped_area_in_place": NAN, "screened_out": NAN, "cluster_area_uniformity": NAN,
+           "cluster_propped_uniformity": NAN}
+    for metric, key in (("cluster_area_uniformity", "area"), ("cluster_propped_uniformity", "closure_propped_area")):
+        clusters: list[float] = []
+        while f"cluster_{len(clusters)}_{key}" in s:
+            clusters.append(float(s[f"cluster_{len(clusters)}_{key}"]))
+        if len(clusters) > 1 and np.mean(clusters) > 0.0:
+            out[metric] = min(clusters) / float(np.mean(clusters))
     if len(results.proppant_snapshots):
         from ..propped import headline_propped
 

@@ -46,7 +46,8 @@ DISTRIBUTIONS = {"uniform": ("low", "high"), "log-uniform": ("low", "high"), "no
                  "triangular": ("low", "mode", "high")}
 #: Metrics a sweep can ask for (hfgpu.ensemble.metrics says how each is computed); the default set is all.
 METRIC_NAMES = ("propped_area", "propped_area_in_place", "created_area", "propped_fraction", "fracture_height",
-                "fracture_length", "net_pressure_end", "efficiency", "screened_out", "cluster_area_uniformity")
+                "fracture_length", "net_pressure_end", "efficiency", "screened_out", "cluster_area_uniformity",
+                "cluster_propped_uniformity")
 
 
 class SweepError(SceneError):

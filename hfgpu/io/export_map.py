@@ -12,12 +12,13 @@ run has proppant, its closure map.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..closure.conductivity import closure_of
+from ..closure.conductivity import ClosureMap, closure_of
 from ..errors import HfgpuError
 from ..records import GridFrame
 
@@ -40,10 +41,23 @@ class ExportMap:
         return next(iter(self.fields.values())).shape
 
 
-def export_map(results) -> ExportMap:
-    """The :class:`ExportMap` of a results file (module docstring); :class:`HfgpuError` when it holds no
-    snapshot."""
+def cluster_closure(closure: ClosureMap, labels: np.ndarray, cluster: int) -> ClosureMap:
+    """Cluster ``cluster``'s columns of a stage's closure map (its clusters side by side; ``labels``: the grid
+    field ``cluster`` of the proppant snapshot it was computed from, hfgpu.stage_blocks)."""
+    columns = np.flatnonzero(np.any(np.asarray(labels) == cluster, axis=0))
+    cut = slice(int(columns[0]), int(columns[-1]) + 1)
+    return dataclasses.replace(closure, fields={name: values[:, cut] for name, values in closure.fields.items()},
+                               clusters=())
+
+
+def export_map(results, cluster: int | None = None) -> ExportMap:
+    """The :class:`ExportMap` of a results file (module docstring); of cluster ``cluster`` of a stage with
+    proppant (``results`` then the cluster's view, :meth:`hfgpu.io.results.Results.cluster`: its fracture
+    snapshots; the closure map cut to its block). :class:`HfgpuError` when it holds no snapshot."""
     closure = closure_of(results) if len(results.proppant_snapshots) else None
+    if closure is not None and cluster is not None:
+        labels = results.proppant_snapshots.at(closure.scalars["time"]).grid["cluster"]
+        closure = cluster_closure(closure, labels, cluster)
     fractures = results.fracture_snapshots
     if not len(fractures):
         if closure is None:

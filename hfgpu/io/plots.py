@@ -31,6 +31,7 @@ from matplotlib.lines import Line2D
 
 from ..errors import HfgpuError
 from ..records import GridFrame, ProppantSnapshot
+from ..stage_blocks import cluster_view, clusters_of
 from .display_units import SI, FigureUnits
 from .results import Results, open_results
 
@@ -348,6 +349,58 @@ def stage_widths(results: Results, units: FigureUnits | None = None) -> Figure:
         _map(fig, ax, snap.frame, u("width", snap.width), f"width [{u.label('width')}]",
              f"cluster {n + 1}: {_number(100 * share, '.3g')} % of the fluid\narea {_number(area)} "
              f"{u.label('area')}, t = {_number(snap.time)} s", limits, colourbar=n == len(snaps) - 1, units=u)
+    return fig
+
+
+def stage_proppant(results: Results, boundaries: Sequence[float] = (), units: FigureUnits | None = None) -> Figure:
+    """The proppant of a stage (its clusters side by side, hfgpu.stage_blocks): one panel per cluster with its
+    proppant volume fraction at the last snapshot (one colour scale), titled with its share of the proppant and
+    its propped area after closure where the summary has it; below, the proppant in each cluster against time
+    (stacked), and each cluster's share of the proppant beside its share of the fluid pumped since the proppant
+    started (``/stage/balance``): the proppant follows the fluid split."""
+    u = _units(results, units)
+    snaps = results.proppant_snapshots
+    last = snaps[-1]
+    n = clusters_of(last)
+    views = [cluster_view(last, i) for i in range(n)]
+    s = results.summary
+    fig = Figure(figsize=(3.6 * n, 8.4), layout="constrained")
+    top, bottom = fig.subfigures(2, 1)
+    axes = top.subplots(1, n, squeeze=False)[0]
+    limits = colour_range(*(v.grid["volume_fraction"] for v in views))
+    for i, (ax, view) in enumerate(zip(axes, views)):
+        title = f"cluster {i + 1}"
+        if f"cluster_{i}_solid_share" in s:
+            title += f": {_number(100 * float(s[f'cluster_{i}_solid_share']), '.3g')} % of the proppant"
+        if f"cluster_{i}_closure_propped_area" in s:
+            title += (f"\npropped {_number(float(u('area', float(s[f'cluster_{i}_closure_propped_area']))))} "
+                      f"{u.label('area')} after closure")
+        _map(top, ax, view.frame, view.grid["volume_fraction"], "volume fraction [-]", title, limits,
+             colourbar=i == n - 1, units=u)
+        _layers_on_map(ax, view.frame, view.grid["volume_fraction"].shape, boundaries, units=u)
+    sand, fluid = bottom.subplots(1, 2)
+    times = np.array([snap.time for snap in snaps])
+    solids = np.array([[float(np.sum(v.parcels["particles"] * 4.0 / 3.0 * np.pi * v.parcels["radius"] ** 3))
+                        for v in (cluster_view(snap, i) for i in range(n))] for snap in snaps])
+    labels = [f"cluster {i + 1}" for i in range(n)]
+    sand.stackplot(times, *u("solid_volume", solids).T, labels=labels)
+    sand.set(xlabel="time [s]", ylabel=f"proppant in the cluster [{u.label('solid_volume')}]",
+             title="where the proppant went")
+    sand.legend(fontsize="small")
+    b = results.stage_balance
+    if b:   # the fluid each cluster took since the proppant started, which carried its proppant
+        start = float(s.get("proppant_start", 0.0))
+        since = b["injected"] - np.array([np.interp(start, b["time"], column) for column in b["injected"].T])
+        total = since.sum(axis=1)
+        pumped = (b["time"] > start) & (total > 0)
+        for i in range(n):
+            fluid.plot(b["time"][pumped], since[pumped, i] / total[pumped], label=labels[i])
+    held = solids.sum(axis=1) > 0.0
+    for i in range(n):
+        fluid.plot(times[held], solids[held, i] / solids[held].sum(axis=1), "o", color=f"C{i}", ms=3)
+    fluid.set(xlabel="time [s]", ylabel="share [-]",
+              title="share of the fluid (lines) and of the proppant (dots) since the proppant started")
+    fluid.legend(fontsize="small")
     return fig
 
 
@@ -766,6 +819,8 @@ def figures(results: Results, units: FigureUnits | None = None) -> dict[str, Fig
         closure = _closure(results)
         if closure is not None:
             out["closure_maps"] = closure_maps(closure, u.system, layers)
+        if clusters_of(last):
+            out["stage_proppant"] = stage_proppant(results, layers, u)
     if results.proppant_balance:
         out["proppant_volume_balance"] = proppant_balance(results, units=u)
     if is_column(results):
@@ -792,7 +847,7 @@ FIGURE_NAMES = {
                  "proppant_volume_balance"),
     "column": ("proppant_interfaces",),
     "coupled": ("proppant_maps", "proppant_streamlines", "proppant_speed_probability", "propped_area"),
-    "stage": ("stage_split", "stage_widths"),
+    "stage": ("stage_split", "stage_widths", "stage_proppant"),
 }
 
 

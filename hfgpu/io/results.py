@@ -37,6 +37,7 @@ to :meth:`ResultsWriter.close`; another process's writer to that file is refused
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import copy
 import functools
 import os
@@ -690,6 +691,11 @@ class Results:
                 return None
             return dict(frame=_frame(group), fields={name: ds[()] for name, ds in group.items()},
                         attrs={k: _plain(v) for k, v in group.attrs.items()})
+
+    def cluster(self, i: int) -> Results:
+        """Cluster ``i`` of a stage read as one fracture's file: its snapshots (``/stage/cluster_<i>/snapshots``) as
+        ``fracture_snapshots``, the rest (balances, proppant, closure: the stage's) as they are."""
+        return dataclasses.replace(self, fracture_snapshots=self.stage_snapshots[i])
 
     @functools.cached_property
     def scene(self):

@@ -178,18 +178,35 @@ def surface_history(balance: dict[str, np.ndarray] | None, scene: Any) -> np.nda
 
 def cluster_rows(summary: dict[str, Any], system: str) -> list[tuple[str, str, str]]:
     """The "clusters" group of a stage of several clusters (``cluster_<i>_*`` of the summary, hfgpu.fracture.stage):
-    one row per cluster, its share of the fluid pumped, its created area, length and height at the end."""
+    one row per cluster, its share of the fluid pumped, its created area, length and height at the end; with
+    proppant (hfgpu.coupled_stage) its share of the proppant and its propped area after closure."""
     n = 0
     while f"cluster_{n}_area" in summary:
         n += 1
     if n < 2:
         return []
     total = sum(float(summary[f"cluster_{i}_injected"]) for i in range(n))
-    share = [format_number(100.0 * summary[f"cluster_{i}_injected"] / total, 3) for i in range(n)]
-    return [("clusters", f"cluster {i + 1}", f"{share[i]} % of the fluid, area "
-             f"{_quantity(summary[f'cluster_{i}_area'], 'area', system)}, length "
-             f"{_quantity(summary[f'cluster_{i}_length'], 'length', system)}, height "
-             f"{_quantity(summary[f'cluster_{i}_height'], 'length', system)}") for i in range(n)]
+    rows = []
+    for i in range(n):
+        text = (f"{format_number(100.0 * summary[f'cluster_{i}_injected'] / total, 3)} % of the fluid, area "
+                f"{_quantity(summary[f'cluster_{i}_area'], 'area', system)}, length "
+                f"{_quantity(summary[f'cluster_{i}_length'], 'length', system)}, height "
+                f"{_quantity(summary[f'cluster_{i}_height'], 'length', system)}")
+        if f"cluster_{i}_solid_share" in summary:
+            text += f"; {format_number(100.0 * summary[f'cluster_{i}_solid_share'], 3)} % of the proppant"
+        if f"cluster_{i}_closure_propped_area" in summary:
+            text += f", propped {_quantity(summary[f'cluster_{i}_closure_propped_area'], 'area', system)}"
+        rows.append(("clusters", f"cluster {i + 1}", text))
+    return rows
+
+
+def _lead_cluster(summary: dict[str, Any]) -> int | None:
+    """The cluster of a stage with the largest propped area after closure, whose half-length, height and F_CD the
+    stage's closure values are (None for one fracture)."""
+    areas = []
+    while f"cluster_{len(areas)}_closure_propped_area" in summary:
+        areas.append(float(summary[f"cluster_{len(areas)}_closure_propped_area"]))
+    return int(np.argmax(areas)) if areas else None
 
 
 def summary_rows(summary: dict[str, Any], system: str = "SI", density: float | None = None,
@@ -266,11 +283,14 @@ def summary_rows(summary: dict[str, Any], system: str = "SI", density: float | N
         if _finite(area) and area > 0:
             text += f" ({format_number(100.0 * propped / area, 3)} % of created)"
         add("proppant", "propped area (after closure)", text)
+        lead = _lead_cluster(s)
         for name, label in (("propped_half_length", "propped half-length"), ("propped_height", "propped height"),
                             ("mean_conductivity", "mean conductivity"), ("fcd", "F_CD")):
             value = s.get(f"closure_{name}")
             if _finite(value):
                 unit = closure_unit(name, system)
+                if lead is not None and name != "mean_conductivity":   # hfgpu.closure.conductivity.close
+                    label += f" (cluster {lead + 1})"
                 add("proppant", label, f"{format_number(closure_in_units(name, value, system))} {unit}".rstrip())
         if s.get("closure_permeability_model") == "kozeny-carman":
             add("proppant", "permeability", "Kozeny-Carman, independent of closure stress (no conductivity table)")

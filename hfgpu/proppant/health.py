@@ -45,19 +45,24 @@ KEYS = {"dt_max": "[mppic] dt_max", "output": "[output] every or the schedule's 
 @dataclass
 class Watch:
     """The checks of the module docstring for one run. ``offset`` [s] moves times onto the scene's clock (the
-    coupled run's proppant phase starts at the end of the pad); ``units`` is the scene's output system."""
+    coupled run's proppant phase starts at the end of the pad); ``units`` is the scene's output system;
+    ``stride`` > 0: the grid holds a stage's clusters side by side every ``stride`` columns (hfgpu.stage_blocks),
+    and a cell is named by its cluster and its x on that cluster's plane."""
 
     theta_cp: float
     smallest_grain: float
     units: str = "SI"
     offset: float = 0.0
+    stride: int = 0
     found: dict[str, str] = field(default_factory=dict)
 
     def _where(self, frame, k: int, i: int) -> str:
         unit = display_unit("length", self.units)
+        cluster, i = divmod(i, self.stride) if self.stride else (-1, i)
         x = in_display_units(frame.x0 + i * frame.dx, "length", self.units)
         z = in_display_units(frame.z0 + k * frame.dz, "length", self.units)
-        return f"x = {format_number(x)} {unit}, depth {format_number(z)} {unit}"
+        where = f"x = {format_number(x)} {unit}, depth {format_number(z)} {unit}"
+        return where if cluster < 0 else f"cluster {cluster + 1}, {where}"
 
     def _width(self, value: float) -> str:
         return f"{format_number(in_display_units(value, 'width', self.units))} {display_unit('width', self.units)}"

@@ -181,11 +181,14 @@ class Injector:
     ``loadings(t)`` gives [(class index, slurry volume fraction)] at time t (from the schedule) and
     ``rate(t0, t1)`` the mean slurry rate over the step [m^3/s]; the solid volume entering over the step is
     c((t0+t1)/2) Q dt, exact while a step stays within one stage (the run loop ends steps at stage ends).
+    ``split(t0, t1)`` (optional) gives each inlet's share of the rate over the step (summing to 1), in place of
+    the ports' constant ``share``: the clusters of a stage, whose fluid split the wellbore node sets
+    (hfgpu.stage_blocks.ClusterSplit); the solids follow the same split.
     """
 
     def __init__(self, ports: tuple[Port, ...], frame: GridFrame, width: np.ndarray,
                  classes: tuple[ProppantClass, ...], particles_per_parcel: list[float], rate, loadings,
-                 rng: np.random.Generator):
+                 rng: np.random.Generator, split=None):
         self.frame = frame
         self.shape = width.shape
         self.classes = classes
@@ -193,6 +196,7 @@ class Injector:
         self.rate = rate
         self.loadings = loadings
         self.rng = rng
+        self.split = split
         self.screened_out = 0.0  # solid volume held back at packed inlets [m^3]
         total = sum(p.share for p in ports)
         self.inlets = [_Inlet(k, i, p.share / total, np.zeros(len(classes)), np.full(len(classes), np.nan),
@@ -202,11 +206,13 @@ class Injector:
     def fluid_sources(self, t0: float, t1: float) -> np.ndarray:
         """Fluid volume rate per cell (nz, nx) [m^3/s]: (1 - c) Q split over the inlets and their cells
         in proportion to the cells' volumes."""
+        self._set_shares(t0, t1)
         q = self.rate(t0, t1) * (1.0 - sum(f for _, f in self.loadings(0.5 * (t0 + t1))))
         return self._spread(q)
 
     def slurry_sources(self, t0: float, t1: float) -> np.ndarray:
         """Slurry volume rate per cell (nz, nx) [m^3/s] (fluid plus solids)."""
+        self._set_shares(t0, t1)
         return self._spread(self.rate(t0, t1))
 
     def jet_speed(self, inlet: _Inlet, t0: float, t1: float) -> float:
@@ -219,6 +225,7 @@ class Injector:
         [m^4/s^2] (the inlet source of the momentum balance, Eq. 8 / 26): on the downstream face of each cell of
         a jet inlet (the face in the jet's direction) its fluid rate (1 - c) Q_cell times the jet speed, signed
         along the axis; u faces (nz, nx+1), v faces (nz+1, nx). Zero for inlets without a jet."""
+        self._set_shares(t0, t1)
         nz, nx = self.shape
         mx, mz = np.zeros((nz, nx + 1)), np.zeros((nz + 1, nx))
         fluid = 1.0 - sum(f for _, f in self.loadings(0.5 * (t0 + t1)))
@@ -233,6 +240,12 @@ class Injector:
             else:
                 np.add.at(mz, (inlet.k + shift, inlet.i), m)
         return mx, mz
+
+    def _set_shares(self, t0: float, t1: float) -> None:
+        """The inlets' shares over (t0, t1] from ``split`` (kept as they are without one)."""
+        if self.split is not None:
+            for inlet, share in zip(self.inlets, self.split(t0, t1)):
+                inlet.share = float(share)
 
     def _spread(self, q: float) -> np.ndarray:
         out = np.zeros(self.shape)
@@ -249,6 +262,7 @@ class Injector:
         ``width`` (the step's width); a parcel is placed only where its bilinear share (Eq. 37) fits the room of
         every cell it lands on (up to PLACEMENT_TRIES random positions in its inlet), else it is held back
         (``screened_out``). ``room`` (float64) is reduced in place by the parcels placed."""
+        self._set_shares(t0, t1)
         q = self.rate(t0, t1) * (t1 - t0)
         mask = None if room is None else deposit_masks(width)[0]
         batches = []

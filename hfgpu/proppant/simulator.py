@@ -148,10 +148,11 @@ class ProppantSimulation:
     injected + opened + supplied = stored + leaked + outflow; ``supplied``: what a width history
     inconsistent with the injection needed beyond it, hfgpu.proppant.fluid.StepInfo), ``seconds`` (wall time [s]
     of the fluid steps, "fluid", and of the parcel sub-loops, "parcels", retries included). ``add_parcels``
-    places extra parcels (counted as injected), e.g. a single test particle.
+    places extra parcels (counted as injected), e.g. a single test particle. ``inlet_split(t0, t1)`` (optional)
+    splits the slurry rate among the inlets over a step (hfgpu.proppant.injection.Injector ``split``).
     """
 
-    def __init__(self, scene, width_field: WidthField | None = None):
+    def __init__(self, scene, width_field: WidthField | None = None, inlet_split=None):
         setup: ProppantSetup = scene.proppant
         self.scene = scene
         self.setup = setup
@@ -182,7 +183,7 @@ class ProppantSimulation:
         self.screen_out_time = math.nan  # start of the first step whose inlets held proppant back
         self.add_parcels(initial_suspension(setup.classes, self.grid.frame, self.grid.width,
                                             self.particles_per_parcel, self.rng, self.numerics.initial_placement))
-        self.injector = self._make_injector(schedule)
+        self.injector = self._make_injector(schedule, inlet_split)
         self.moments = self.engine.moments()
         n = self.numerics
         self.solver = FluidSolver(self.grid, self.rho_f, self.mu_f,
@@ -202,7 +203,7 @@ class ProppantSimulation:
 
     # -- set-up ---------------------------------------------------------------------------------------
 
-    def _make_injector(self, schedule) -> Injector | None:
+    def _make_injector(self, schedule, split) -> Injector | None:
         ports = self.setup.geometry.inlets
         if schedule is None:
             return None
@@ -215,7 +216,7 @@ class ProppantSimulation:
             return [] if name is None else [(names.index(name), fraction)]
 
         return Injector(ports, self.grid.frame, self.grid.width, self.setup.classes, self.particles_per_parcel,
-                        rate=schedule.mean_rate, loadings=loadings, rng=self.rng)
+                        rate=schedule.mean_rate, loadings=loadings, rng=self.rng, split=split)
 
     def _set_width(self, t: float) -> None:
         width, leakoff = self.width_field(t)

@@ -93,7 +93,7 @@ def test_documented_example_parses(tmp_path):
     ("members = 4\n" + VARY + 'values = [6e7]\n[metrics]\nnames = ["propped_area", "height"]\n',
      "sweep key 'metrics.names[1]': got 'height'; allowed: 'propped_area', 'propped_area_in_place', "
      "'created_area', 'propped_fraction', 'fracture_height', 'fracture_length', 'net_pressure_end', "
-     "'efficiency', 'screened_out', 'cluster_area_uniformity'"),
+     "'efficiency', 'screened_out', 'cluster_area_uniformity', 'cluster_propped_uniformity'"),
 ])
 def test_bad_sweep_names_the_key(write_sweep, body, message):
     with pytest.raises(SweepError) as info:
