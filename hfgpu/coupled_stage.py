@@ -18,7 +18,7 @@ proppant's prefixed ``proppant_``, and per cluster ``cluster_<i>_solid`` (proppa
 [m^3]), ``cluster_<i>_solid_share`` (its share of the proppant in the stage), ``cluster_<i>_propped_area``
 (cells whose proppant would cover the width when closed, hfgpu.propped.propped_cells) and
 ``cluster_<i>_created_area`` (open cells of its block). The closure after the run adds each cluster's
-conductivity values (hfgpu.runner). No checkpoints (a stage writes none) and no two-way mode.
+conductivity values (hfgpu.runner). Checkpoints as the single fracture's coupled run; no two-way mode.
 """
 
 from __future__ import annotations
@@ -95,14 +95,30 @@ def union_frame(frames: list[tuple[GridFrame, tuple[int, int]]]) -> tuple[GridFr
 def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] | None = None,
              timings: Timings | None = None, checkpoint=None, resume: dict | None = None) -> dict:
     """Run the coupled stage (module docstring); ``sink`` gets the stage's fracture records and the proppant
-    records (on the scene's clock). ``checkpoint`` and ``resume`` are not used (a stage writes no checkpoints)."""
+    records (on the scene's clock).
+
+    Checkpoints as :func:`hfgpu.coupled.simulate`'s: {"phase": "fracture", "fracture": <the stage's>}, then
+    {"phase": "proppant", "fracture_summary" (its scalars), "screen_out", "proppant": <the proppant model's>};
+    ``resume`` is such a state plus what the results file kept before it: "stage_snapshots" (each cluster's
+    fracture snapshots) and "stage_balance" (``/stage/balance``, the clusters' injected volumes)."""
     timings = timings if timings is not None else Timings()
     cfg = scene.coupling
     n = scene.completion.clusters
     tee = _StageTee(sink, timings, n)
     fracture_scene = scene.replace(output=dataclasses.replace(scene.output, every=cfg.fracture_every))
-    with timings.measure("fracture"):
-        fracture = stage.simulate(fracture_scene, tee, progress)
+    phase = resume["phase"] if resume is not None else "fracture"
+    if resume is not None:
+        tee.clusters = [list(snaps) for snaps in resume["stage_snapshots"]]
+        kept = resume["stage_balance"]
+        if kept:
+            tee.times, tee.injected = list(kept["time"]), [list(row) for row in kept["injected"]]
+    if phase == "fracture":
+        with timings.measure("fracture"):
+            fracture = stage.simulate(fracture_scene, tee, progress, resume=resume and resume["fracture"],
+                                      checkpoint=checkpoint and checkpoint.within(
+                                          0.0, lambda state: {"phase": "fracture", "fracture": state}))
+    else:
+        fracture = resume["fracture_summary"]
     histories = [FractureHistory(snaps) for snaps in tee.clusters]
     start = late_start(scene, proppant_start_time(scene), min(float(h.times[0]) for h in histories))
     source = injection_cell_centre(scene)
@@ -124,9 +140,20 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
                              inlet_split=lambda t0, t1: split(t0 + start, t1 + start))
     sim.watch.offset, sim.watch.stride = start, blocks.stride
     shift = _Labelled(sink, start, scene.proppant.params.bridging_factor, timings, blocks.labels())
+    if phase == "proppant":
+        shift.restore(resume["screen_out"])
+    elif checkpoint is not None:
+        checkpoint.restart(start)
+    scalars = {k: v for k, v in fracture.items() if isinstance(v, (int, float, str))}
+
+    def wrap(state: dict) -> dict:
+        return {"phase": "proppant", "fracture_summary": scalars, "screen_out": shift.state(), "proppant": state}
+
     if hasattr(progress, "phase"):  # hfgpu.io.progress.Progress: a bar of its own for the proppant phase
         progress.phase("proppant", start)
-    proppant = sim.run(shift, None if progress is None else shifted(progress, start))
+    proppant = sim.run(shift, None if progress is None else shifted(progress, start),
+                       checkpoint=checkpoint and checkpoint.within(start, wrap),
+                       resume=resume["proppant"] if phase == "proppant" else None)
     timings.add(sim.seconds)
     warn_screen_out(proppant, scene.proppant.params.theta_cp, offset=start)
     proppant["screen_out_time"] += start

@@ -246,6 +246,9 @@ def _reopen(scene: Scene, out: Path):
     kept = open_results(out)
     if len(scene.run.physics) > 1:
         state["fracture_snapshots"] = kept.fracture_snapshots[:]
+        if scene.completion is not None:   # a stage's proppant (hfgpu.coupled_stage)
+            state["stage_snapshots"] = [snaps[:] for snaps in kept.stage_snapshots]
+            state["stage_balance"] = kept.stage_balance
     return writer, time, state, kept
 
 

@@ -26,7 +26,8 @@ step are in the summary (``stage_iterations``, ``unconverged_steps``) and docs/v
 Time steps: the stage's step is the smallest of the planes' next steps (Eq. 35); when a plane takes a shorter
 step (a retry, a long front advance) every plane redoes the step at that length. After the pumps stop each
 cluster keeps its fluid (no cross-flow through the wellbore). One cluster without friction, offset or neighbour
-runs the single-plane engine's steps unchanged. A stage run writes no checkpoints.
+runs the single-plane engine's steps unchanged. Checkpoints hold every plane's engine state and the node's split
+(:meth:`StageEngine.state`).
 """
 
 from __future__ import annotations
@@ -219,6 +220,31 @@ class StageEngine:
     def next_dt(self, dt_prev: float) -> float:
         return min(plane.next_dt(dt_prev) for plane in self.planes)
 
+    def state(self) -> dict:
+        """Everything needed to continue from now (a checkpoint): each plane's engine state, each inlet's booked
+        volume, the split and the counters. The shadow's sources are the planes' widths, cast again on restore."""
+        return {"planes": {f"plane_{k}": p.state() for k, p in enumerate(self.planes)},
+                "inlets": np.array([[i.t_c, i.v_c, i.share] for i in self.inlets]),
+                "t": self.t, "rates": self.rates.copy(), "step_rates": self.step_rates.copy(),
+                "slopes": np.array([]) if self.slopes is None else self.slopes.copy(),
+                "p_wellbore": self.p_wellbore, "iterations": self.iterations, "unconverged": self.unconverged,
+                "steps": self.steps, "max_balance_error": self.max_balance_error.copy()}
+
+    def restore(self, state: dict) -> None:
+        """Continue from a :meth:`state` of a stage of the same scene."""
+        for k, plane in enumerate(self.planes):
+            plane.restore(state["planes"][f"plane_{k}"])
+        for inlet, (t_c, v_c, share) in zip(self.inlets, np.asarray(state["inlets"])):
+            inlet.t_c, inlet.v_c, inlet.share = float(t_c), float(v_c), float(share)
+        self.t = float(state["t"])
+        self.rates, self.step_rates = np.array(state["rates"]), np.array(state["step_rates"])
+        self.slopes = np.array(state["slopes"]) if np.size(state["slopes"]) else None
+        self.p_wellbore = float(state["p_wellbore"])
+        self.iterations, self.unconverged = int(state["iterations"]), int(state["unconverged"])
+        self.steps, self.max_balance_error = int(state["steps"]), np.array(state["max_balance_error"])
+        self.sources = [self._widths(plane) for plane in self.planes]
+        self._shadow_fields()
+
     def record(self) -> StageRecord:
         """The stage at the current time: each cluster's balance record, rate and the wellbore pressure."""
         return StageRecord(time=self.t, wellbore_pressure=self.p_wellbore, rates=self.step_rates.copy(),
@@ -249,17 +275,24 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
     it) every cluster's (:class:`hfgpu.records.StageSnapshot`). Returns simulator.simulate's summary of the
     stage (summed volumes and area) with ``clusters`` (one summary per cluster: its volumes, footprint, rate,
     inlet pressure, front extents), ``wellbore_pressure``, ``stage_iterations`` and ``unconverged_steps``.
-    ``checkpoint`` and ``resume`` are not used (a stage writes no checkpoints)."""
+    Checkpoints as simulator.simulate's: ``checkpoint.save(t, {"stage": StageEngine.state(), "dt": next step,
+    "target": index of the step target})`` after the first step past each interval; ``resume`` continues from
+    such a state."""
     check_scene(scene)
     numerics = scene.fracture if scene.fracture is not None else FractureNumerics()
     stage = StageEngine(scene, numerics)
     first = stage.planes[0]
     targets, outputs = _times(scene, stage.t0)
     dt = numerics.time_step_relaxation * min(first.dx, first.dz) / first.v_front
-    k = 0
+    index = 0
+    if resume is not None:
+        stage.restore(resume["stage"])
+        dt, index = float(resume["dt"]), int(resume["target"])
+    k = sum(1 for t in outputs if t < stage.t or _landed(t, stage.t)) if resume is not None else 0
     stage_record = getattr(sink, "stage_record", None)
     stage_snapshot = getattr(sink, "stage_snapshot", None)
-    for target in targets:
+    for index in range(index, len(targets)):
+        target = targets[index]
         while stage.t < target * (1 - 1e-12):
             remaining = target - stage.t
             step = min(dt, remaining)
@@ -295,6 +328,8 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
                         stage_snapshot(StageSnapshot(i, snap))
                 k += 1
             dt = stage.next_dt(dt if taken == step else taken)
+            if checkpoint is not None and checkpoint.due(stage.t):
+                checkpoint.save(stage.t, {"stage": stage.state(), "dt": dt, "target": index})
     return summary(stage)
 
 

@@ -347,15 +347,17 @@ class ResultsWriter:
                 raise HfgpuError(f"'{path}' holds no checkpoint to resume from (status "
                                  f"\"{f.attrs.get('status', 'running')}\"); run the scene again without --resume")
             a = group.attrs
-            counts = {physics: int(a[f"{physics}_snapshots"]) for physics in ("fracture", "proppant")}
-            for physics in counts:
+            counts = {key[:-len("_snapshots")]: int(a[key]) for key in a if key.endswith("_snapshots")}
+            for physics in counts:   # fracture, proppant and a stage's stage/cluster_<i>
                 parent = f.get(f"{physics}/snapshots")
                 for name in list(parent) if parent is not None else []:
                     if not name.isdigit() or int(name) >= counts[physics]:
                         del parent[name]
+            for physics in ("fracture", "proppant", "stage"):
                 balance = f.get(f"{physics}/balance")
+                rows = int(a.get(f"{physics}_balance_rows", 0))
                 for ds in balance.values() if balance is not None else []:
-                    ds.resize((int(a[f"{physics}_balance_rows"]),))
+                    ds.resize((rows,) + ds.shape[1:])
             f.pop("summary", None)
             f.attrs["status"] = "running"
             time, state = float(a["time"]), read_tree(group["state"])
@@ -421,7 +423,7 @@ class ResultsWriter:
             group = f.create_group(NEW_CHECKPOINT)
             write_tree(group.create_group("state"), state)
             rows_now = {}
-            for physics in self._counts:
+            for physics in ("fracture", "proppant", "stage"):
                 column = f.get(f"{physics}/balance/time")
                 rows_now[f"{physics}_balance_rows"] = column.shape[0] if column is not None else 0
             group.attrs.update(time=float(time), **counts, **rows_now)

@@ -226,6 +226,34 @@ def test_coupled_run_resumes_in_either_phase(after, phase, reference, tmp_path, 
         assert got[key] == ref[key], key
 
 
+#: COUPLED as a stage of two clusters 30 m apart (hfgpu.coupled_stage), twice the rate.
+STAGE = COUPLED.replace('rate = "2e-3 m**3/s"', 'rate = "4e-3 m**3/s"') + '[completion]\nclusters = 2\nspacing = "30 m"\n'
+
+
+@pytest.mark.parametrize("after, phase", [(2, "fracture"), (15, "proppant")])
+def test_a_stage_with_proppant_resumes_in_either_phase(after, phase, tmp_path, monkeypatch):
+    """A stage's checkpoint holds every plane and the wellbore node's split (hfgpu.fracture.stage), the resumed
+    file's stage rows and cluster snapshots are cut back to it, and the resumed run equals the uninterrupted one bit
+    for bit."""
+    plain, path = tmp_path / "plain.h5", tmp_path / "stage.h5"
+    hfgpu.run(load_scene(_no_checkpoints(STAGE)), plain, progress=False)
+    _interrupted(monkeypatch, STAGE, path, after, 3)
+    with h5py.File(path, "r", locking=False) as f:
+        assert f["checkpoint/state"].attrs["phase"] == phase
+        rows = f["checkpoint"].attrs["stage_balance_rows"]
+    hfgpu.run(load_scene(STAGE), path, progress=False, resume=True)
+    _assert_same_results(plain, path)
+    a, b = open_results(plain), open_results(path)
+    assert rows > 0 and a.stage_balance.keys() == b.stage_balance.keys()
+    for name, column in a.stage_balance.items():
+        assert np.array_equal(column, b.stage_balance[name], equal_nan=True), name
+    for x, y in zip(a.stage_snapshots, b.stage_snapshots):
+        assert len(x) == len(y) and all(np.array_equal(s.width, t.width) for s, t in zip(x, y))
+    for key in ("fracture_steps", "fracture_stage_iterations", "proppant_steps", "proppant_in_domain",
+                "cluster_0_solid", "cluster_1_solid", "cluster_1_closure_propped_area"):
+        assert b.summary[key] == a.summary[key], key
+
+
 def _signalled_once_checkpointed(tmp_path: Path, path: Path, number: int) -> tuple[list[str], int, str]:
     """Start ``hfgpu run`` on the fracture scene (checkpoints every 3 s) into ``path``, send it signal ``number``
     once the file holds a checkpoint; (the command, its exit code, its stderr)."""
