@@ -87,6 +87,23 @@ def test_the_injector_splits_fluid_and_solids_by_the_split():
     assert np.all(np.abs(emitted - expected) <= parcel * 1.0001)
 
 
+def test_an_inlet_whose_cells_closed_takes_no_fluid_and_says_so():
+    """A starved cluster's perforation cells close on the proppant grid: its share of the fluid does not enter
+    (a source in a closed cell would be refused by the fluid step), the other inlets keep theirs, one warning."""
+    frame = GridFrame(dx=1.0, dz=1.0, x0=0.0, z0=0.0)
+    width = np.full((4, 9), 0.01)
+    sand = ProppantClass("sand", 2650.0, SizeDistribution("fixed", 3e-4, 3e-4, 3e-4))
+    ports = (Port("point", x=1.0, depth=1.0), Port("point", x=7.0, depth=2.0))
+    injector = Injector(ports, frame, width, (sand,), [100.0], rate=lambda t0, t1: 1e-3, loadings=lambda t: [],
+                        rng=np.random.default_rng(1), split=lambda t0, t1: np.array([0.6, 0.4]))
+    closed = width.copy()
+    closed[2, 7] = 0.0
+    with pytest.warns(RuntimeWarning, match="inlet 2's cells are closed"):
+        sources = injector.fluid_sources(0.0, 1.0, closed)
+    assert sources[1, 1] == pytest.approx(0.6e-3, rel=1e-12) and sources[2, 7] == 0.0 and sources.sum() == sources[1, 1]
+    assert injector.fluid_sources(1.0, 2.0, width)[2, 7] == pytest.approx(0.4e-3, rel=1e-12)
+
+
 def test_a_stage_with_proppant_runs_the_coupled_stage_and_refuses_two_way():
     scene = load_scene(tiny_stage("clusters = 2\nspacing = \"500 m\"\n"))
     assert simulator_module(scene) == "hfgpu.coupled_stage"

@@ -18,6 +18,7 @@ injected = in_domain + outflow + screened_out stays exact.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -197,18 +198,20 @@ class Injector:
         self.loadings = loadings
         self.rng = rng
         self.split = split
+        self.closed: set[int] = set()   # inlets found with every cell closed (warned once each)
         self.screened_out = 0.0  # solid volume held back at packed inlets [m^3]
         total = sum(p.share for p in ports)
         self.inlets = [_Inlet(k, i, p.share / total, np.zeros(len(classes)), np.full(len(classes), np.nan),
                               p.jet, jet_area(k, i, p.jet, frame, width))
                        for p, (k, i) in zip(ports, ports_to_cells(ports, frame, width, "geometry.inlets"))]
 
-    def fluid_sources(self, t0: float, t1: float) -> np.ndarray:
-        """Fluid volume rate per cell (nz, nx) [m^3/s]: (1 - c) Q split over the inlets and their cells
-        in proportion to the cells' volumes."""
+    def fluid_sources(self, t0: float, t1: float, width: np.ndarray | None = None) -> np.ndarray:
+        """Fluid volume rate per cell (nz, nx) [m^3/s]: (1 - c) Q split over the inlets, and an inlet's part equally
+        over its cells, those open in ``width`` (the step's) where given: an inlet whose cells have all closed
+        (a starved cluster's perforation, hfgpu.coupled_stage) takes none, and a RuntimeWarning line says so."""
         self._set_shares(t0, t1)
         q = self.rate(t0, t1) * (1.0 - sum(f for _, f in self.loadings(0.5 * (t0 + t1))))
-        return self._spread(q)
+        return self._spread(q, width, t0)
 
     def slurry_sources(self, t0: float, t1: float) -> np.ndarray:
         """Slurry volume rate per cell (nz, nx) [m^3/s] (fluid plus solids)."""
@@ -247,10 +250,21 @@ class Injector:
             for inlet, share in zip(self.inlets, self.split(t0, t1)):
                 inlet.share = float(share)
 
-    def _spread(self, q: float) -> np.ndarray:
+    def _spread(self, q: float, width: np.ndarray | None = None, t: float = 0.0) -> np.ndarray:
         out = np.zeros(self.shape)
-        for inlet in self.inlets:
-            np.add.at(out, (inlet.k, inlet.i), q * inlet.share / inlet.k.size)
+        for n, inlet in enumerate(self.inlets):
+            k, i = inlet.k, inlet.i
+            if width is not None:
+                open_cells = width[k, i] > 0.0
+                k, i = k[open_cells], i[open_cells]
+                if not k.size:
+                    if q * inlet.share > 0.0 and n not in self.closed:
+                        self.closed.add(n)
+                        warnings.warn(f"inlet {n + 1}'s cells are closed at t = {t:.4g} s (on the proppant run's "
+                                      f"clock): its share of the rate ({100 * inlet.share:.3g} %) does not enter "
+                                      "the proppant grid while they stay closed", RuntimeWarning, stacklevel=4)
+                    continue
+            np.add.at(out, (k, i), q * inlet.share / k.size)
         return out
 
     def emit(self, t0: float, t1: float, room: np.ndarray | None = None,

@@ -288,7 +288,7 @@ class ProppantSimulation:
             loop = self.engine.substeps(dt, self.numerics.particle_substeps, t0)
             self.seconds["parcels"] += perf_counter() - t_a
             self.moments = self.engine.moments()
-            sources, momentum = ((self.injector.fluid_sources(t0, t0 + dt), self.injector.jet_momentum(t0, t0 + dt))
+            sources, momentum = ((self.injector.fluid_sources(t0, t0 + dt, self.grid.width), self.injector.jet_momentum(t0, t0 + dt))
                                  if self.injector is not None else (np.zeros(self.grid.shape), (None, None)))
             trial = self.solver.copy_state(self.fluid)
             theta_p, t_a = self._fluid_theta_p(), perf_counter()
