@@ -29,7 +29,8 @@ from typing import Callable
 
 import numpy as np
 
-from .coupled import Timings, _FractureTee, _ProppantShift, late_start, proppant_scene, proppant_start_time
+from .coupled import (Timings, _FractureTee, _ProppantShift, late_start, proppant_scene, proppant_start_time,
+                      warn_inconsistent_width)
 from .coupling import FractureHistory, proppant_frame
 from .fracture import stage
 from .fracture.mesh import injection_cell_centre
@@ -156,6 +157,7 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
                        resume=resume["proppant"] if phase == "proppant" else None)
     timings.add(sim.seconds)
     warn_screen_out(proppant, scene.proppant.params.theta_cp, offset=start)
+    warn_inconsistent_width(proppant)
     proppant["screen_out_time"] += start
     last = sim.snapshot()
     last = dataclasses.replace(last, grid={**last.grid, "cluster": blocks.labels()})
