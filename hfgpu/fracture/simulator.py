@@ -11,8 +11,8 @@ moved more than ``max_front_advance`` cells, is redone with half the step (``max
 Newton failure raises SimulationError naming time, cell and residual, a long advance is accepted), so the front
 does not over-run on long steps. Cells squeezed shut stay closed at w = 0 (contact, newton.solve_step). The
 injected volume of a step is exact (Schedule.mean_rate), leak-off is Carter's law integrated exactly
-(:mod:`leakoff`), and the flux form conserves volume, so injected = stored + leaked to the Newton tolerance at
-every step.
+(:mod:`leakoff`), the flux form conserves volume and each accepted step's widths balance its volume exactly
+(newton.solve_step's volume-conserving shift), so injected = stored + leaked to round-off at every step.
 
 Start. The run starts at t0 from a radial fracture of radius R0 = ``initial_radius_cells`` cells around the
 injection cell's centre (the cells whose centres lie inside it; the grid is placed on the layer boundaries,
