@@ -41,6 +41,7 @@ import numpy as np
 from ..perforations import Entry, split_rate
 from ..records import BalanceRecord, StageRecord, StageSnapshot
 from .config import FractureNumerics
+from .engine_setup import fracture_engine_setup
 from .shadow import PlanesOperator
 from .simulator import _Engine, _landed, _times, MIN_STEP_FRACTION, check_scene
 from .views import front_extents, geometry, snapshot
@@ -89,8 +90,8 @@ class StageEngine:
         n = completion.clusters
         self.pump = scene.injection.schedule
         self.inlets = [ClusterInlet(self.pump, 1.0 / n) for _ in range(n)]
-        self.planes = [_Engine(scene.replace(injection=dataclasses.replace(scene.injection, schedule=inlet)),
-                               numerics) for inlet in self.inlets]
+        setup = dataclasses.replace(fracture_engine_setup(scene), numerics=numerics)
+        self.planes = [_Engine(dataclasses.replace(setup, schedule=inlet)) for inlet in self.inlets]
         first = self.planes[0]
         self.t0 = self.t = first.t0
         for inlet in self.inlets:   # the starting fractures hold Q t0 / N each

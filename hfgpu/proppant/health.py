@@ -44,13 +44,12 @@ KEYS = {"dt_max": "[mppic] dt_max", "output": "[output] every or the schedule's 
 
 @dataclass
 class Watch:
-    """The checks of the module docstring for one run. ``offset`` [s] moves times onto the scene's clock (the
-    coupled run's proppant phase starts at the end of the pad); ``units`` is the scene's output system."""
+    """The checks of the module docstring for one run (times on the scene's clock); ``units`` is the scene's
+    output system."""
 
     theta_cp: float
     smallest_grain: float
     units: str = "SI"
-    offset: float = 0.0
     found: dict[str, str] = field(default_factory=dict)
 
     def _where(self, frame, k: int, i: int) -> str:
@@ -65,7 +64,7 @@ class Watch:
     def _report(self, kind: str, t: float, text: str) -> None:
         if kind in self.found:
             return
-        line = f"{kind} at t = {format_number(t + self.offset)} s: {text}"
+        line = f"{kind} at t = {format_number(t)} s: {text}"
         self.found[kind] = line
         warnings.warn(line, RuntimeWarning, stacklevel=3)
 
@@ -98,7 +97,7 @@ class Watch:
         text = (f"step {dt:.3g} s against {nominal:.3g} s, bounded by the {bound} ({KEYS[bound]}); "
                 + self.fastest(frame, fast_cell(), width, theta))
         if dt < COLLAPSE_FLOOR * nominal:
-            raise SimulationError(f"the proppant step collapsed: {text}", time=t + self.offset)
+            raise SimulationError(f"the proppant step collapsed: {text}", time=t)
         self._report("collapsing step", t, text)
 
     def fastest(self, frame, cell: tuple[int, int], width: np.ndarray, theta: np.ndarray) -> str:
