@@ -200,10 +200,11 @@ def _davis(scene: Scene) -> tuple[int, int, int, dict]:
     """Interface depths every step (upper: light theta_p at half phi_L', lower: heavy at half phi_H), then
     least-squares speeds over :data:`DAVIS_WINDOW` (as tests/proppant/test_davis.py)."""
     from hfgpu.proppant.analysis import class_volume_fraction, fitted_speed, interface_depth, row_profile
+    from hfgpu.proppant.engine_setup import proppant_engine_setup
     from hfgpu.proppant.simulator import ProppantSimulation
 
     theory = _davis_theory(scene)
-    sim = ProppantSimulation(scene)
+    sim = ProppantSimulation(proppant_engine_setup(scene))
     phi_heavy = scene.proppant.classes[0].initial_volume_fraction
     record = []
 

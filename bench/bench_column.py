@@ -25,6 +25,7 @@ import numpy as np
 
 from hfgpu import load_scene
 from hfgpu.proppant.analysis import interface_depth, row_profile
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 from hfgpu.reference import settling
 
@@ -61,8 +62,8 @@ THETA0 = 0.06
 
 def run(columns: int, gap: str, placement: str, averaging: str, end: float) -> dict:
     """One box to ``end`` [s]; the row of the table."""
-    sim = ProppantSimulation(load_scene(SCENE.format(end=end, length=4 * columns, gap=gap, placement=placement,
-                                                     averaging=averaging)))
+    scene = load_scene(SCENE.format(end=end, length=4 * columns, gap=gap, placement=placement, averaging=averaging))
+    sim = ProppantSimulation(proppant_engine_setup(scene))
     cls = sim.setup.classes[0]
     hindered = settling.hindered_velocity(settling.stokes_velocity(cls.size.mean, cls.density, sim.rho_f, sim.mu_f),
                                           THETA0, settling.STOKES_RZ_EXPONENT)

@@ -17,6 +17,7 @@ import numpy as np  # noqa: E402
 
 from hfgpu import load_scene  # noqa: E402
 from hfgpu.proppant.analysis import class_volume_fraction, fitted_speed, interface_depth, row_profile  # noqa: E402
+from hfgpu.proppant.engine_setup import proppant_engine_setup  # noqa: E402
 from hfgpu.proppant.simulator import ProppantSimulation  # noqa: E402
 from hfgpu.reference.settling import bidisperse_batch, bidisperse_interface_heights  # noqa: E402
 from hfgpu.records import MemorySink  # noqa: E402
@@ -38,7 +39,7 @@ def main() -> None:
     theory = bidisperse_batch((heavy.size.mean / 2, heavy.density, heavy.initial_volume_fraction),
                               (light.size.mean / 2, light.density, light.initial_volume_fraction),
                               scene.fluid.density, scene.fluid.viscosity)
-    sim = ProppantSimulation(scene)
+    sim = ProppantSimulation(proppant_engine_setup(scene))
     height = scene.proppant.geometry.height
     history = []
 

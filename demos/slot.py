@@ -20,6 +20,7 @@ import numpy as np  # noqa: E402
 
 from hfgpu import load_scene  # noqa: E402
 from hfgpu.proppant.analysis import bank, bed_height  # noqa: E402
+from hfgpu.proppant.engine_setup import proppant_engine_setup  # noqa: E402
 from hfgpu.proppant.simulator import ProppantSimulation  # noqa: E402
 from hfgpu.records import MemorySink  # noqa: E402
 
@@ -39,7 +40,7 @@ def main() -> None:
     scene = load_scene(args.scene)
     if args.end is not None:
         scene = scene.replace(run=type(scene.run)(args.end, scene.run.physics, scene.run.seed))
-    sim = ProppantSimulation(scene)
+    sim = ProppantSimulation(proppant_engine_setup(scene))
     sink = MemorySink()
     summary = sim.run(sink, progress=lambda t: None)
     out = Path(args.out)

@@ -56,14 +56,15 @@ from .coupling import FractureHistory, proppant_frame, screen_out_cells
 from .coupling_config import DEFAULT_INLET_CELLS
 from .engines import FractureEngine, ProppantEngine
 from .errors import SceneError
+from .fracture.engine_setup import fracture_engine_setup
 from .fracture.mesh import injection_cell_centre
-from .fracture.simulator import FractureRun, simulate as simulate_fracture
-from .io.progress import shifted
+from .fracture.simulator import FractureRun
 from .io.sink import FractureSink, ProppantSink, ResultsSink
 from .proppant.config import Geometry, Port
+from .proppant.engine_setup import proppant_engine_setup
 from .proppant.simulator import ProppantSimulation, warn_screen_out
 from .records import BalanceRecord, FractureSnapshot, GridFrame, ProppantSnapshot, SolidBalanceRecord
-from .scene import Scene, Schedule
+from .scene import Scene
 from .slurry_feedback import packed_cells, slurry_of
 
 def proppant_start_time(scene: Scene) -> float:
@@ -93,48 +94,26 @@ def late_start(scene: Scene, start: float, first: float) -> float:
     return first
 
 
-def shifted_schedule(schedule: Schedule, start: float) -> Schedule:
-    """The schedule seen from ``start`` on (times minus start; a stage cut at start keeps the loading it has
-    there, ramping on to its end value)."""
-    stages, begin = [], 0.0
-    for stage in schedule.stages:
-        if stage.until > start:
-            fraction = stage.volume_fraction
-            if begin < start:
-                s = (start - begin) / (stage.until - begin)
-                fraction += s * (stage.end_volume_fraction - stage.volume_fraction)
-            stages.append(dataclasses.replace(stage, until=stage.until - start, volume_fraction=fraction))
-        begin = stage.until
-    return Schedule(tuple(stages))
-
-
-def proppant_scene(scene: Scene, frame: GridFrame, shape: tuple[int, int], width: np.ndarray,
-                   start: float) -> Scene:
-    """The proppant-only scene of the coupled run: a "field" geometry on (frame, shape) with the width at
-    ``start``, the annular inlet around the perforation, clocks shifted so that its t = 0 is ``start``."""
+def proppant_geometry(scene: Scene, frame: GridFrame, shape: tuple[int, int], width: np.ndarray) -> Geometry:
+    """The coupled run's proppant domain: a "field" geometry on (frame, shape) with ``width``, and the annular
+    inlet around the perforation (``[coupling] inlet_inner_radius``, ``inlet_radius``)."""
     nz, nx = shape
     x, z = frame.centres(nz, nx)
-    inj, cfg = scene.injection, scene.coupling
+    cfg = scene.coupling
     outer = cfg.inlet_radius if cfg.inlet_radius is not None else DEFAULT_INLET_CELLS * max(frame.dx, frame.dz)
     x_inj, z_inj = injection_cell_centre(scene)   # the fracture's source cell, which holds the perforation
     inlet = Port("annulus", x=x_inj, depth=z_inj, inner_radius=cfg.inlet_inner_radius, outer_radius=outer)
-    geometry = Geometry(kind="field", length=nx * frame.dx, height=nz * frame.dz, field_x=x, field_z=z,
-                        field_w=np.asarray(width, dtype=np.float64), inlets=(inlet,))
-    return scene.replace(
-        run=dataclasses.replace(scene.run, end_time=scene.run.end_time - start, physics=("proppant",)),
-        injection=dataclasses.replace(inj, schedule=shifted_schedule(inj.schedule, start)),
-        proppant=dataclasses.replace(scene.proppant, geometry=geometry),
-        mesh=dataclasses.replace(scene.mesh, dx=frame.dx, dz=frame.dz))
+    return Geometry(kind="field", length=nx * frame.dx, height=nz * frame.dz, field_x=x, field_z=z,
+                    field_w=np.asarray(width, dtype=np.float64), inlets=(inlet,))
 
 
 def proppant_simulation(scene: Scene, frame: GridFrame, shape: tuple[int, int], start: float,
                         width_at: Callable[[float], tuple[np.ndarray, np.ndarray]]) -> ProppantSimulation:
-    """The proppant run of the coupled scene from ``start`` (:func:`proppant_scene`; its clock is 0 there) on the
-    grid (frame, shape), its walls ``width_at(t)`` = (width, leak-off rate) at the scene's time t."""
-    sim = ProppantSimulation(proppant_scene(scene, frame, shape, width_at(start)[0], start),
-                             width_field=lambda t: width_at(t + start))
-    sim.watch.offset = start
-    return sim
+    """The proppant run of the coupled scene from ``start`` on the grid (frame, shape) (:func:`proppant_geometry`),
+    its walls ``width_at(t)`` = (width, leak-off rate) at the scene's time t. It keeps the scene's clock: it
+    starts at ``start``, ``advance(t)`` steps to the scene's time t, its records carry the scene's times."""
+    geometry = proppant_geometry(scene, frame, shape, width_at(start)[0])
+    return ProppantSimulation(proppant_engine_setup(scene, geometry=geometry, start=start), width_field=width_at)
 
 
 class Timings:
@@ -201,11 +180,12 @@ class _Snapshots:
         pass
 
 
-class _ProppantShift:
-    """Sink of the proppant phase: times moved back by ``start``, ``bridging_risk`` added to the grid."""
+class _BridgingRisk:
+    """Sink of the proppant phase: ``bridging_risk`` added to each snapshot's grid (screen_out_cells), the
+    flagged cells counted; records go on to ``sink``."""
 
-    def __init__(self, sink: ProppantSink, start: float, factor: float, timings: Timings):
-        self.start, self.factor = start, factor
+    def __init__(self, sink: ProppantSink, factor: float, timings: Timings):
+        self.factor = factor
         self.sink, self.timings = sink, timings
         self.flagged = 0
         self.flagged_max = 0
@@ -213,19 +193,17 @@ class _ProppantShift:
 
     def proppant_snapshot(self, snap: ProppantSnapshot) -> None:
         risk = screen_out_cells(snap, self.factor)
-        t = snap.time + self.start
         self.flagged = int(risk.sum())
         self.flagged_max = max(self.flagged_max, self.flagged)
         if self.flagged and math.isnan(self.first_time):
-            self.first_time = t
-        shifted_snap = dataclasses.replace(snap, time=t, grid={**snap.grid, "bridging_risk": risk.astype(np.int8)})
+            self.first_time = snap.time
+        flagged = dataclasses.replace(snap, grid={**snap.grid, "bridging_risk": risk.astype(np.int8)})
         with self.timings.measure("io"):
-            self.sink.proppant_snapshot(shifted_snap)
+            self.sink.proppant_snapshot(flagged)
 
     def proppant_balance(self, record: SolidBalanceRecord) -> None:
-        shifted_record = dataclasses.replace(record, time=record.time + self.start)
         with self.timings.measure("io"):
-            self.sink.proppant_balance(shifted_record)
+            self.sink.proppant_balance(record)
 
     def state(self) -> dict:
         """The screen-out counters (a checkpoint)."""
@@ -234,6 +212,18 @@ class _ProppantShift:
     def restore(self, state: dict) -> None:
         self.flagged, self.flagged_max = state["flagged"], state["flagged_max"]
         self.first_time = state["first_time"]
+
+
+def _on_scene_clock(resume: dict, start: float) -> dict:
+    """The proppant state of a coupled checkpoint, its times on the scene's clock: as stored when the checkpoint
+    says ``clock = "scene"``, else (a file written when the proppant run's clock started at 0 at the proppant
+    start) with ``start`` added to its time, next snapshot time and screen-out time."""
+    state = resume["proppant"]
+    if resume.get("clock") == "scene":
+        return state
+    simulation = dict(state["simulation"], time=state["simulation"]["time"] + start,
+                      screen_out_time=state["simulation"]["screen_out_time"] + start)
+    return dict(state, simulation=simulation, next_out=state["next_out"] + start)
 
 
 #: Share of the injected fluid above which a width history's mismatch is reported (warn_inconsistent_width).
@@ -272,8 +262,8 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
     counts and ``time_<phase>`` wall times.
 
     Checkpoints (hfgpu.io.checkpoint): ``checkpoint`` gets {"phase": "fracture", "fracture": <the fracture
-    engine's>} during the fracture phase, then {"phase": "proppant", "fracture_summary", "screen_out" (the
-    bridging counters), "proppant": <the proppant model's>}; ``resume`` is such a state plus
+    engine's>} during the fracture phase, then {"phase": "proppant", "clock": "scene", "fracture_summary",
+    "screen_out" (the bridging counters), "proppant": <the proppant model's, on the scene's clock>}; ``resume`` is such a state plus
     "fracture_snapshots", the fracture snapshots the results file kept (the history before the checkpoint).
     """
     if scene.coupling.mode == "two-way":
@@ -282,46 +272,60 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
     start = proppant_start_time(scene)
     cfg = scene.coupling
     tee = _FractureTee(sink, timings)
-    fracture_scene = scene.replace(output=dataclasses.replace(scene.output, every=cfg.fracture_every))
+    fracture_setup = fracture_engine_setup(scene, every=cfg.fracture_every)
     phase = resume["phase"] if resume is not None else "fracture"
     if resume is not None:
         tee.snapshots = list(resume["fracture_snapshots"])
     if phase == "fracture":
         with timings.measure("fracture"):
-            fracture = simulate_fracture(fracture_scene, tee, progress, resume=resume and resume["fracture"],
-                                         checkpoint=checkpoint and checkpoint.within(
-                                             0.0, lambda state: {"phase": "fracture", "fracture": state}))
+            run = FractureRun(fracture_setup, tee, progress, resume=resume and resume["fracture"],
+                              checkpoint=checkpoint and checkpoint.within(
+                                  0.0, lambda state: {"phase": "fracture", "fracture": state}))
+            run.advance(fracture_setup.end_time)
+            fracture = run.summary()
     else:
         fracture = resume["fracture_summary"]
     history = FractureHistory(tee.snapshots)
     start = late_start(scene, start, float(history.times[0]))
     frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=injection_cell_centre(scene))
     sim = proppant_simulation(scene, frame, shape, start, history.width_field(frame, shape, cfg.min_width))
-    shift = _ProppantShift(sink, start, scene.proppant.params.bridging_factor, timings)
-    if phase == "proppant":
-        shift.restore(resume["screen_out"])
+    risk = _BridgingRisk(sink, scene.proppant.params.bridging_factor, timings)
+    proppant = proppant_phase(sim, risk, start, fracture, scene.proppant.params.theta_cp, timings, progress,
+                              checkpoint, resume)
+    summary = {f"fracture_{k}": v for k, v in fracture.items()}
+    summary.update({f"proppant_{k}": v for k, v in proppant.items()})
+    summary.update(proppant_start=start, proppant_nx=shape[1], proppant_nz=shape[0], proppant_dx=frame.dx,
+                   proppant_dz=frame.dz, screen_out_cells=risk.flagged, screen_out_cells_max=risk.flagged_max,
+                   screen_out_first_time=risk.first_time, time=scene.run.end_time)
+    summary.update({f"time_{k}": v for k, v in timings.seconds.items()})
+    return summary
+
+
+def proppant_phase(sim: ProppantSimulation, risk: _BridgingRisk, start: float, fracture: dict, theta_cp: float,
+                   timings: Timings, progress: Callable[[float], None] | None, checkpoint, resume: dict | None) -> dict:
+    """The one-way run's proppant phase from ``start`` (the fracture done, its summary ``fracture``): ``sim`` run to
+    the end into ``risk`` (the bridging-risk sink), its checkpoints {"phase": "proppant", "clock": "scene",
+    "fracture_summary": ``fracture``, "screen_out", "proppant"}, resumed from ``resume`` when that is a
+    proppant-phase state; returns the proppant summary, after the warnings on a screen-out and on a width history
+    inconsistent with the injection."""
+    resuming = resume is not None and resume["phase"] == "proppant"
+    if resuming:
+        risk.restore(resume["screen_out"])
     elif checkpoint is not None:
         checkpoint.restart(start)
 
     def wrap(state: dict) -> dict:
-        return {"phase": "proppant", "fracture_summary": fracture, "screen_out": shift.state(), "proppant": state}
+        return {"phase": "proppant", "clock": "scene", "fracture_summary": fracture, "screen_out": risk.state(),
+                "proppant": state}
 
     if hasattr(progress, "phase"):  # hfgpu.io.progress.Progress: a bar of its own for the proppant phase
         progress.phase("proppant", start)
-    proppant = sim.run(shift, None if progress is None else shifted(progress, start),
-                       checkpoint=checkpoint and checkpoint.within(start, wrap),
-                       resume=resume["proppant"] if phase == "proppant" else None)
+    proppant = sim.run(risk, progress, checkpoint=checkpoint and checkpoint.within(0.0, wrap),
+                       resume=_on_scene_clock(resume, start) if resuming else None)
     timings.add(sim.seconds)
-    warn_screen_out(proppant, scene.proppant.params.theta_cp, offset=start)
+    warn_screen_out(proppant, theta_cp)
     warn_inconsistent_width(proppant)
-    proppant["screen_out_time"] += start
-    summary = {f"fracture_{k}": v for k, v in fracture.items()}
-    summary.update({f"proppant_{k}": v for k, v in proppant.items()}, proppant_time=proppant["time"] + start)
-    summary.update(proppant_start=start, proppant_nx=shape[1], proppant_nz=shape[0], proppant_dx=frame.dx,
-                   proppant_dz=frame.dz, screen_out_cells=shift.flagged, screen_out_cells_max=shift.flagged_max,
-                   screen_out_first_time=shift.first_time, time=scene.run.end_time)
-    summary.update({f"time_{k}": v for k, v in timings.seconds.items()})
-    return summary
+    return proppant
 
 
 def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] | None = None,
@@ -346,21 +350,21 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
     timings = timings if timings is not None else Timings()
     timings.seconds.update(footprint=0.0, feedback=0.0)
     cfg, params = scene.coupling, scene.proppant.params
-    fracture_scene = scene.replace(output=dataclasses.replace(scene.output, every=cfg.fracture_every))
+    fracture_setup = fracture_engine_setup(scene, every=cfg.fracture_every)
     with timings.measure("footprint"):
         clean = _Snapshots()
-        simulate_fracture(fracture_scene, clean)
+        FractureRun(fracture_setup, clean).advance(fracture_setup.end_time)
         history = FractureHistory(clean.snapshots)
         start = late_start(scene, proppant_start_time(scene), float(history.times[0]))
         frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=injection_cell_centre(scene))
 
     tee = _FractureTee(sink, timings)
-    run: FractureEngine = FractureRun(fracture_scene, tee, progress)
+    run: FractureEngine = FractureRun(fracture_setup, tee, progress)
     with timings.measure("fracture"):
         run.advance(start)
     geometry = {"width": FractureHistory(tee.snapshots).width_field(frame, shape, cfg.min_width)}
     sim: ProppantEngine = proppant_simulation(scene, frame, shape, start, lambda t: geometry["width"](t))
-    shift = _ProppantShift(sink, start, params.bridging_factor, timings)
+    risk = _BridgingRisk(sink, params.bridging_factor, timings)
     every = cfg.fracture_every
     ends = [every * k for k in range(int(math.floor(start / every + 1e-9)) + 1,
                                      int(math.floor(scene.run.end_time / every + 1e-9)) + 1)]
@@ -370,7 +374,7 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
         with timings.measure("fracture"):
             run.advance(t_next)
         geometry["width"] = FractureHistory(tee.snapshots).width_field(frame, shape, cfg.min_width)
-        sim.advance(t_next - start, shift)
+        sim.advance(t_next, risk)
         with timings.measure("feedback"):
             run.use_slurry(slurry_of(sim.snapshot(), params))
         p_net = tee.last.net_pressure
@@ -378,18 +382,17 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
             t_screen_out, p_screen_out = t_next, p_net
         if not math.isnan(t_screen_out):
             p_max = max(p_max, p_net)
-    proppant = sim.finish(shift)
+    proppant = sim.finish(risk)
     timings.add(sim.seconds)
-    warn_screen_out(proppant, params.theta_cp, offset=start)
+    warn_screen_out(proppant, params.theta_cp)
     warn_inconsistent_width(proppant)
-    proppant["screen_out_time"] += start
     fracture = run.summary()
     packed = packed_cells(sim.snapshot(), params).any(axis=0)
     summary = {f"fracture_{k}": v for k, v in fracture.items()}
-    summary.update({f"proppant_{k}": v for k, v in proppant.items()}, proppant_time=proppant["time"] + start)
+    summary.update({f"proppant_{k}": v for k, v in proppant.items()})
     summary.update(proppant_start=start, proppant_nx=shape[1], proppant_nz=shape[0], proppant_dx=frame.dx,
-                   proppant_dz=frame.dz, screen_out_cells=shift.flagged, screen_out_cells_max=shift.flagged_max,
-                   screen_out_first_time=shift.first_time, time=scene.run.end_time,
+                   proppant_dz=frame.dz, screen_out_cells=risk.flagged, screen_out_cells_max=risk.flagged_max,
+                   screen_out_first_time=risk.first_time, time=scene.run.end_time,
                    tip_screen_out_time=t_screen_out, net_pressure_rise=p_max - p_screen_out,
                    packed_length=float(packed.sum()) * frame.dx)
     summary.update({f"time_{k}": v for k, v in timings.seconds.items()})

@@ -29,16 +29,17 @@ from typing import Callable
 
 import numpy as np
 
-from .coupled import (Timings, _FractureTee, _ProppantShift, late_start, proppant_scene, proppant_start_time,
-                      warn_inconsistent_width)
+from .coupled import (Timings, _BridgingRisk, _FractureTee, late_start, proppant_geometry, proppant_phase,
+                      proppant_start_time)
 from .coupling import FractureHistory, proppant_frame
 from .fracture import stage
+from .fracture.engine_setup import fracture_engine_setup
 from .fracture.mesh import injection_cell_centre
-from .io.progress import shifted
 from .io.sink import ResultsSink
 from .propped import created_area, propped_cells
 from .proppant.config import Port
-from .proppant.simulator import ProppantSimulation, warn_screen_out
+from .proppant.engine_setup import proppant_engine_setup
+from .proppant.simulator import ProppantSimulation
 from .records import GridFrame, ProppantSnapshot, StageRecord, StageSnapshot
 from .scene import Scene
 from .stage_blocks import Blocks, ClusterSplit, cluster_view
@@ -70,11 +71,11 @@ class _StageTee(_FractureTee):
                 forward(record)
 
 
-class _Labelled(_ProppantShift):
-    """The proppant phase's sink (hfgpu.coupled._ProppantShift) adding the grid field ``cluster``."""
+class _Labelled(_BridgingRisk):
+    """The proppant phase's sink (hfgpu.coupled._BridgingRisk) adding the grid field ``cluster``."""
 
-    def __init__(self, sink, start: float, factor: float, timings: Timings, labels: np.ndarray):
-        super().__init__(sink, start, factor, timings)
+    def __init__(self, sink, factor: float, timings: Timings, labels: np.ndarray):
+        super().__init__(sink, factor, timings)
         self.labels = labels
 
     def proppant_snapshot(self, snap: ProppantSnapshot) -> None:
@@ -99,14 +100,14 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
     records (on the scene's clock).
 
     Checkpoints as :func:`hfgpu.coupled.simulate`'s: {"phase": "fracture", "fracture": <the stage's>}, then
-    {"phase": "proppant", "fracture_summary" (its scalars), "screen_out", "proppant": <the proppant model's>};
+    {"phase": "proppant", "clock": "scene", "fracture_summary" (its scalars), "screen_out", "proppant"};
     ``resume`` is such a state plus what the results file kept before it: "stage_snapshots" (each cluster's
     fracture snapshots) and "stage_balance" (``/stage/balance``, the clusters' injected volumes)."""
     timings = timings if timings is not None else Timings()
     cfg = scene.coupling
     n = scene.completion.clusters
     tee = _StageTee(sink, timings, n)
-    fracture_scene = scene.replace(output=dataclasses.replace(scene.output, every=cfg.fracture_every))
+    setup = fracture_engine_setup(scene, every=cfg.fracture_every)
     phase = resume["phase"] if resume is not None else "fracture"
     if resume is not None:
         tee.clusters = [list(snaps) for snaps in resume["stage_snapshots"]]
@@ -115,9 +116,10 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
             tee.times, tee.injected = list(kept["time"]), [list(row) for row in kept["injected"]]
     if phase == "fracture":
         with timings.measure("fracture"):
-            fracture = stage.simulate(fracture_scene, tee, progress, resume=resume and resume["fracture"],
-                                      checkpoint=checkpoint and checkpoint.within(
-                                          0.0, lambda state: {"phase": "fracture", "fracture": state}))
+            fracture = stage.run(setup, scene.completion, scene.fluid.density, tee, progress,
+                                 checkpoint=checkpoint and checkpoint.within(
+                                     0.0, lambda state: {"phase": "fracture", "fracture": state}),
+                                 resume=resume and resume["fracture"])
     else:
         fracture = resume["fracture_summary"]
     histories = [FractureHistory(snaps) for snaps in tee.clusters]
@@ -131,42 +133,25 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
         pairs = [f(t) for f in fields]
         return blocks.tile([p[0] for p in pairs]), blocks.tile([p[1] for p in pairs])
 
-    tiled = proppant_scene(scene, frame, blocks.tiled_shape, width_at(start)[0], start)
-    (port,) = tiled.proppant.geometry.inlets
-    ports = tuple(dataclasses.replace(port, x=port.x + blocks.shift(i)) for i in range(n))
-    tiled = tiled.replace(proppant=dataclasses.replace(
-        tiled.proppant, geometry=dataclasses.replace(tiled.proppant.geometry, inlets=ports)))
-    split = ClusterSplit(np.array(tee.times), np.array(tee.injected))
-    sim = ProppantSimulation(tiled, width_field=lambda t: width_at(t + start),
-                             inlet_split=lambda t0, t1: split(t0 + start, t1 + start))
-    sim.watch.offset, sim.watch.stride = start, blocks.stride
-    shift = _Labelled(sink, start, scene.proppant.params.bridging_factor, timings, blocks.labels())
-    if phase == "proppant":
-        shift.restore(resume["screen_out"])
-    elif checkpoint is not None:
-        checkpoint.restart(start)
-    scalars = {k: v for k, v in fracture.items() if isinstance(v, (int, float, str))}
-
-    def wrap(state: dict) -> dict:
-        return {"phase": "proppant", "fracture_summary": scalars, "screen_out": shift.state(), "proppant": state}
-
-    if hasattr(progress, "phase"):  # hfgpu.io.progress.Progress: a bar of its own for the proppant phase
-        progress.phase("proppant", start)
-    proppant = sim.run(shift, None if progress is None else shifted(progress, start),
-                       checkpoint=checkpoint and checkpoint.within(start, wrap),
-                       resume=resume["proppant"] if phase == "proppant" else None)
-    timings.add(sim.seconds)
-    warn_screen_out(proppant, scene.proppant.params.theta_cp, offset=start)
-    warn_inconsistent_width(proppant)
-    proppant["screen_out_time"] += start
+    geometry = proppant_geometry(scene, frame, blocks.tiled_shape, width_at(start)[0])
+    (port,) = geometry.inlets
+    geometry = dataclasses.replace(geometry, inlets=tuple(dataclasses.replace(port, x=port.x + blocks.shift(i))
+                                                          for i in range(n)))
+    sim = ProppantSimulation(proppant_engine_setup(scene, geometry=geometry, start=start), width_field=width_at,
+                             inlet_split=ClusterSplit(np.array(tee.times), np.array(tee.injected)))
+    sim.watch.stride = blocks.stride
+    risk = _Labelled(sink, scene.proppant.params.bridging_factor, timings, blocks.labels())
+    scalars = {k: v for k, v in fracture.items() if isinstance(v, (int, float, str))}   # a checkpoint's
+    proppant = proppant_phase(sim, risk, start, scalars, scene.proppant.params.theta_cp, timings, progress,
+                              checkpoint, resume)
     last = sim.snapshot()
     last = dataclasses.replace(last, grid={**last.grid, "cluster": blocks.labels()})
     summary = {(k if k.startswith("cluster_") else f"fracture_{k}"): v for k, v in fracture.items()}
-    summary.update({f"proppant_{k}": v for k, v in proppant.items()}, proppant_time=proppant["time"] + start)
+    summary.update({f"proppant_{k}": v for k, v in proppant.items()})
     summary.update(proppant_start=start, proppant_nx=blocks.tiled_shape[1], proppant_nz=shape[0],
                    proppant_dx=frame.dx, proppant_dz=frame.dz, proppant_cluster_nx=shape[1],
-                   screen_out_cells=shift.flagged, screen_out_cells_max=shift.flagged_max,
-                   screen_out_first_time=shift.first_time, time=scene.run.end_time)
+                   screen_out_cells=risk.flagged, screen_out_cells_max=risk.flagged_max,
+                   screen_out_first_time=risk.first_time, time=scene.run.end_time)
     summary.update(cluster_values(last, n, scene.proppant.params.theta_cp))
     summary.update({f"time_{k}": v for k, v in timings.seconds.items()})
     return summary

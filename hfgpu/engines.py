@@ -1,5 +1,6 @@
-"""The fracture and the proppant engine as the coupled loop drives them (hfgpu.coupled), as protocols: each keeps
-its own clock and steps to a time it is given; the loop hands the fracture the slurry between intervals.
+"""The fracture and the proppant engine as the coupled loop drives them (hfgpu.coupled), as protocols: each is built
+from its own typed frozen setup (hfgpu.fracture.engine_setup, hfgpu.proppant.engine_setup), keeps its own clock on
+the scene's time and steps to a time it is given; the loop hands the fracture the slurry between intervals.
 :class:`hfgpu.fracture.simulator.FractureRun` and :class:`hfgpu.proppant.simulator.ProppantSimulation` take them.
 """
 
@@ -22,7 +23,7 @@ class FractureEngine(Protocol):
         """Its clock [s] (the scene's)."""
 
     def advance(self, until: float) -> None:
-        """Step to ``until`` [s], a step landing on it."""
+        """Step to ``until`` [s, the scene's clock], a step landing on it."""
 
     def use_slurry(self, slurry: Slurry) -> None:
         """Step on in this slurry (viscosity ratios, blocked cells, the width floor after shut-in)."""
@@ -40,14 +41,15 @@ class ProppantEngine(Protocol):
 
     @property
     def time(self) -> float:
-        """Its clock [s] (0 at the proppant start of a coupled run)."""
+        """Its clock [s] (the scene's: its setup's ``start`` before the first step)."""
 
     @property
     def seconds(self) -> dict[str, float]:
         """Wall time [s] of its own phases: "fluid" (the fluid steps) and "parcels" (the parcel sub-loops)."""
 
     def advance(self, until: float, sink: ProppantSink) -> None:
-        """Step to ``until`` [s], a step landing on it, writing the snapshots due and a balance record a step."""
+        """Step to ``until`` [s, the scene's clock], a step landing on it, writing the snapshots due and a balance
+        record a step."""
 
     def snapshot(self) -> ProppantSnapshot:
         """Parcels and grid fields now."""

@@ -130,7 +130,7 @@ def estimated_parcels(scene) -> float | None:
         cell_volumes = np.zeros(0)
         ppp = [setup.numerics.particles_per_parcel] * len(setup.classes)
     else:
-        grid = build_grid(setup.geometry, scene.mesh)
+        grid = build_grid(setup.geometry, scene.mesh.dx, scene.mesh.dz)
         cell_volumes = grid.cell_volume[grid.active]
         ppp = particles_per_parcel(setup, schedule, float(np.median(cell_volumes)))
     total = 0.0
@@ -156,7 +156,7 @@ def grid_cells(scene) -> float:
     geometry = scene.proppant.geometry
     if geometry.kind not in ("box", "slot"):
         return 0.0
-    nz, nx = box_shape(geometry, scene.mesh)
+    nz, nx = box_shape(geometry, scene.mesh.dx, scene.mesh.dz)
     return float(nz) * float(nx)
 
 

@@ -14,10 +14,11 @@ import numpy as np
 import pytest
 
 from hfgpu import load_scene, open_results, run
-from hfgpu.coupled import late_start, proppant_start_time, screen_out_cells, shifted_schedule
+from hfgpu.coupled import late_start, proppant_start_time, screen_out_cells
 from hfgpu.coupling import FractureHistory
 from hfgpu.coupling_config import CouplingConfig
 from hfgpu.errors import SceneError
+from hfgpu.proppant.simulator import scheduled_solid_volume
 from hfgpu.scene import Schedule, Stage
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -218,13 +219,14 @@ def test_scene_without_a_proppant_stage_is_refused():
         proppant_start_time(scene)
 
 
-def test_shifted_schedule_keeps_rates_and_the_ramp():
+def test_a_proppant_run_from_its_start_counts_the_schedule_from_there():
+    """The coupled proppant run starts at the proppant start on the scene's clock; the solids its parcel budget
+    counts (hfgpu.proppant.simulator.particles_per_parcel) are those pumped from then on, a stage cut there from
+    the loading it has then."""
     s = Schedule((Stage(10.0, 1.0), Stage(30.0, 2.0, "a", 0.1, 0.3)))
-    shifted = shifted_schedule(s, 20.0)
-    assert shifted.stages == (Stage(10.0, 2.0, "a", 0.2, 0.3),)
-    for t in (0.0, 4.0, 9.0):
-        assert shifted.proppant_fraction(t)[1] == pytest.approx(s.proppant_fraction(t + 20.0)[1])
-        assert shifted.volume(t) == pytest.approx(s.volume(t + 20.0) - s.volume(20.0))
+    assert scheduled_solid_volume(s, "a", 20.0) == pytest.approx(s.solid_volume(20.0, 30.0), rel=1e-14)
+    assert scheduled_solid_volume(s, "a") == pytest.approx(s.solid_volume(0.0, 30.0), rel=1e-14)
+    assert scheduled_solid_volume(s, "a", 5.0) == scheduled_solid_volume(s, "a")
 
 
 # -- the five-layer treatment (section 6): trends, never the paper's numbers -----------------------

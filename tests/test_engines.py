@@ -7,7 +7,9 @@ import inspect
 
 from hfgpu import load_scene, scene_path
 from hfgpu.engines import FractureEngine, ProppantEngine
+from hfgpu.fracture.engine_setup import fracture_engine_setup
 from hfgpu.fracture.simulator import FractureRun
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 from hfgpu.records import MemorySink
 
@@ -25,13 +27,13 @@ def _takes_the_protocols_calls(cls: type, protocol: type) -> None:
 
 
 def test_the_fracture_run_is_a_fracture_engine():
-    run = FractureRun(load_scene(scene_path("radial_I.toml")), MemorySink())
+    run = FractureRun(fracture_engine_setup(load_scene(scene_path("radial_I.toml"))), MemorySink())
     assert isinstance(run, FractureEngine)
     assert run.time == run.engine.t0 and run.tips_held() == 0
     _takes_the_protocols_calls(FractureRun, FractureEngine)
 
 
 def test_the_proppant_simulation_is_a_proppant_engine():
-    sim = ProppantSimulation(load_scene(scene_path("settling_stokes.toml")))
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(scene_path("settling_stokes.toml"))))
     assert isinstance(sim, ProppantEngine) and sim.time == 0.0
     _takes_the_protocols_calls(ProppantSimulation, ProppantEngine)

@@ -1,5 +1,6 @@
 """``hfgpu check`` and ``hfgpu run`` read a scene once: one TOML parse, one validation, one set of physics checks
-and one estimate per command (issue 35, item 4)."""
+(the fracture engine's start checks among them) and one estimate per command, in both coupling modes (issue 35,
+item 4): the engines take typed setups and check nothing again."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from pathlib import Path
 import pytest
 
 import hfgpu.estimate
+import hfgpu.fracture.simulator
 import hfgpu.limits
 import hfgpu.runner
 import hfgpu.scene
@@ -20,7 +22,7 @@ TINY = Path(__file__).resolve().parent / "scenes" / "tiny_coupled.toml"
 #: (module, function) of each step counted; a module that imported the function by name counts there too.
 COUNTED = ((tomllib, "loads"), (hfgpu.scene, "parse_scene"), (hfgpu.scene_checks, "validate"),
            (hfgpu.runner, "validate"), (hfgpu.limits, "check_limits"), (hfgpu.limits, "check_engine_start"),
-           (hfgpu.estimate, "estimate"), (hfgpu.scene_checks, "estimate"))
+           (hfgpu.estimate, "estimate"), (hfgpu.scene_checks, "estimate"), (hfgpu.fracture.simulator, "check_scene"))
 
 
 @pytest.fixture
@@ -38,7 +40,8 @@ def calls(monkeypatch) -> collections.Counter:
     return counter
 
 
-ONCE = {"loads": 1, "parse_scene": 1, "validate": 1, "check_limits": 1, "check_engine_start": 1, "estimate": 1}
+ONCE = {"loads": 1, "parse_scene": 1, "validate": 1, "check_limits": 1, "check_engine_start": 1, "estimate": 1,
+        "check_scene": 1}
 
 
 def test_check_reads_and_checks_the_scene_once(calls, capsys):
@@ -47,7 +50,11 @@ def test_check_reads_and_checks_the_scene_once(calls, capsys):
     assert dict(calls) == ONCE
 
 
-def test_run_reads_and_checks_the_scene_once(calls, tmp_path):
-    assert main(["run", str(TINY), "--out", str(tmp_path / "r.h5"), "--no-progress"]) == 0
+@pytest.mark.parametrize("mode", ["one-way", "two-way"])
+def test_run_reads_and_checks_the_scene_once(calls, tmp_path, mode):
+    path = tmp_path / "tiny.toml"
+    path.write_text(TINY.read_text().replace('fracture_every = "5 s"', f'fracture_every = "5 s"\nmode = "{mode}"'))
+    calls.clear()
+    assert main(["run", str(path), "--out", str(tmp_path / "r.h5"), "--no-progress"]) == 0
     assert dict(calls) == ONCE
 

@@ -53,7 +53,7 @@ def test_collapsed_step_stops_the_run_and_resume_with_a_changed_key_finishes_it(
 
 
 def _watch() -> tuple[Watch, GridFrame]:
-    return Watch(theta_cp=0.6, smallest_grain=100e-6, units="field", offset=900.0), GridFrame(6.0, 6.0, 0.0, 3000.0)
+    return Watch(theta_cp=0.6, smallest_grain=100e-6, units="field"), GridFrame(6.0, 6.0, 0.0, 3000.0)
 
 
 def test_overpacked_cell_warns_once_with_place_and_width():
@@ -63,10 +63,10 @@ def test_overpacked_cell_warns_once_with_place_and_width():
     theta[1, 2] = 0.7
     with pytest.warns(RuntimeWarning, match=r"theta_p above close packing at t = 1 000 s: theta_p 0.7 .* "
                                             r"x = 39.37 ft, depth 9 862 ft, 0.07874 in wide"):
-        watch.after_step(100.0, frame, width, theta)
+        watch.after_step(1000.0, frame, width, theta)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        watch.after_step(110.0, frame, width, theta)  # reported once
+        watch.after_step(1010.0, frame, width, theta)  # reported once
     assert watch.summary()["unphysical_states"].startswith("theta_p above close packing at t = 1 000 s")
 
 
@@ -98,8 +98,8 @@ def test_proppant_in_a_cell_narrower_than_a_grain_warns_but_a_deposit_trace_does
     theta[0, 2] = 0.005  # a neighbour's deposit share
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        watch.after_step(1.0, frame, width, theta)
+        watch.after_step(901.0, frame, width, theta)
     theta[0, 2] = 0.05
     with pytest.warns(RuntimeWarning, match=r"proppant in cells narrower than a grain at t = 902 s: theta_p 0.05 "
                                             r"in the cell at x = 39.37 ft"):
-        watch.after_step(2.0, frame, width, theta)
+        watch.after_step(902.0, frame, width, theta)

@@ -40,7 +40,9 @@ def test_fluid_and_solid_balances_hold_at_every_step(both, mode):
     summary, r = both[mode]
     b = r.fracture_balance
     fluid = np.abs(b["injected"] - b["stored"] - b["leaked"]) / b["injected"]
-    assert fluid.max() < 1e-10 and summary["fracture_max_balance_error"] < 1e-10
+    # each accepted step balances its volume to round-off (hfgpu.fracture.newton._volume_conserving): measured
+    # 3e-16 one-way, 8e-13 two-way before it (the leak-off ramp's curvature over Newton's last update)
+    assert fluid.max() < 1e-13 and summary["fracture_max_balance_error"] < 1e-13
     s = r.proppant_balance
     solid = np.abs(s["injected"] - s["in_domain"] - s["outflow"] - s["screened_out"])
     assert np.all(solid <= 1e-10 * np.maximum(s["injected"], 1e-300))
@@ -122,7 +124,7 @@ def test_the_frac_pack_scene_screens_out(tmp_path):
     # 61 m packed; the fracture does not close (its walls rest on the pack)
     assert 120.0 < s["tip_screen_out_time"] < 600.0
     assert s["net_pressure_rise"] > 2e6 and s["packed_length"] > 0.0
-    assert np.isnan(s["fracture_closed_at"]) and s["fracture_max_balance_error"] < 1e-10
+    assert np.isnan(s["fracture_closed_at"]) and s["fracture_max_balance_error"] < 1e-13
     b = open_results(tmp_path / "tso.h5").fracture_balance
     w0 = np.interp([s["tip_screen_out_time"], 600.0], b["time"], b["inlet_width"])
     assert w0[1] > 1.5 * w0[0]                                 # widening behind the bridged tip (measured 3x)

@@ -77,7 +77,7 @@ class CellFront:
         new = g.unsolved(view.t)
         if not new.any():
             return new
-        sigma = engine.scene.rock.min_stress_at(g.centres()[1])
+        sigma = engine.setup.rock.min_stress_at(g.centres()[1])
         wet = g["active"] & ~new & (g["w"] > 0.0)
         fed = np.zeros(new.shape, bool)
         for dk, di in DIRECTIONS:

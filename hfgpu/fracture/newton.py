@@ -42,6 +42,15 @@ repeated solves of a step each save about one iteration. The whole-cell front ke
 moves the widths within eps, and the proppant transport of a coupled run, which follows the widths, would take
 a different sequence of steps.
 
+Volume-conserving acceptance (``_volume_conserving``). Summed over the cells, Eq. 29 is the step's volume balance
+(the fluxes cancel): sum F = A sum (w - w_old) + leaked - injected. The update of a converged Newton iteration
+is within eps ||w||, and the leak-off ramp's curvature over it, A dL g'' dw^2 / 2 per cell, leaves sum F at a
+level set by the tolerance where cells drain to near their ramp width (cells near closure, a tip held by
+bridged proppant: 1e-11 of the injected volume a step at eps = 1e-6 in hfgpu/scenes/frac_pack_tso.toml, summing
+to 1.5e-10 over its steps). The accepted widths are shifted at the open cells by the one uniform width that
+makes sum F = 0, a scalar Newton on a monotone function; the shift is of the order of sum F over the open area,
+far below the tolerance's width, and the balance holds to round-off at every step.
+
 Contact. Widths cannot go negative (the faces would interpenetrate). After Newton converges, an open cell
 with w < 0 is closed: its width is held at 0 and its unknown becomes its fluid pressure (p = sigma + c0 x,
 c0 = C_PP, so x is in metres), which is no longer tied to the elastic relation Eq. 28 (the difference
@@ -344,6 +353,35 @@ def _volume_exact(prob: StepProblem, r: Residual, dx: np.ndarray, closed: np.nda
     return dx - np.where(closed, 0.0, (r.f.sum() + a @ dx) / total)
 
 
+#: Scalar Newton iterations of the volume-conserving shift (``_volume_conserving``; two reach round-off).
+VOLUME_SHIFT_ITERATIONS = 3
+
+
+def _volume_conserving(prob: StepProblem, elastic: Elasticity, x: np.ndarray, closed: np.ndarray) -> np.ndarray:
+    """The converged iterate x shifted by the uniform width s at the open cells that makes the step's volume
+    balance exact, sum_P F_P(x + s) = 0 to round-off. The lubrication fluxes cancel in the sum, so it is the
+    scalar V(s) = sum_P F_P(x) + sum_open A (s + dL (g(w + s) - g(w))), increasing in s (V' >= A per open cell),
+    solved by Newton from s = 0. An update within Newton's tolerance leaves sum F at the leak-off ramp's
+    curvature over that update, A dL g'' dw^2 / 2 per cell, large where a cell's width is near the ramp's w_eps
+    (cells near closure, a front held at the tip): injected - stored - leaked would collect it step by step. The
+    shift is of the order of that sum over the open area, far below the tolerance's width."""
+    open_ = ~closed
+    if not open_.any():
+        return x
+    r = residual(prob, elastic, x, closed)
+    f0, n = float(r.f.sum()), int(open_.sum())
+    demand = np.broadcast_to(prob.demand, x.shape)
+    s = 0.0
+    for _ in range(VOLUME_SHIFT_ITERATIONS):
+        g, dg = leak_fraction(prob, np.where(open_, r.w + s, r.w))
+        volume = f0 + prob.area * (s * n + float(np.sum(np.where(open_, demand * (g - r.g), 0.0))))
+        slope = prob.area * (n + float(np.sum(np.where(open_, demand * dg, 0.0))))
+        if not (np.isfinite(volume) and slope > 0.0):
+            return x
+        s -= volume / slope
+    return np.where(open_, x + s, x)
+
+
 def _gmres_update(prob, elastic, f, lap, cond, diag, tolerance, closed, precond, work: NewtonWork):
     """(dx, M) by _krylov_update with M reused when given; a GMRES that fails with a reused M is rerun with
     a new one (its work added to ``work``)."""
@@ -395,7 +433,8 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
     the simplified correction is below it, module docstring), then the contact set is updated
     (cells with w < 0 closed, closed cells whose fluid pressure exceeds sigma + C w opened) and Newton rerun
     until it settles (at most CONTACT_PASSES times; a set still moving is solved once more as it stands, so
-    that the step's residual, hence its volume balance, is converged); never raises on failure.
+    that the step's residual is converged); a converged iterate is then shifted to balance the step's volume
+    exactly (``_volume_conserving``); never raises on failure.
     ``closed_start``: cells that start closed (the contact set of the previous step: with it, a step whose set
     does not change needs one Newton pass instead of two). ``preconditioner``: StepResult.preconditioner of an
     earlier solve on the same active cells and contact set (Newton-Krylov: its SuperLU is tried first instead
@@ -428,6 +467,8 @@ def solve_step(prob: StepProblem, elastic: Elasticity, tolerance: float, max_ite
         x, converged, it, preconditioner = _newton(prob, elastic, x, closed, tolerance, max_iterations, work,
                                                    preconditioner, simplified_exit)
         iterations += it
+    if converged:
+        x = _volume_conserving(prob, elastic, x, closed)
     r = residual(prob, elastic, x, closed)
     ok = converged and bool(np.all(np.isfinite(r.f)))
     return StepResult(w=r.w, p=r.p, leaked=prob.area * prob.demand * r.g, iterations=iterations, converged=ok,

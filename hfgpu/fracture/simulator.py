@@ -11,8 +11,8 @@ moved more than ``max_front_advance`` cells, is redone with half the step (``max
 Newton failure raises SimulationError naming time, cell and residual, a long advance is accepted), so the front
 does not over-run on long steps. Cells squeezed shut stay closed at w = 0 (contact, newton.solve_step). The
 injected volume of a step is exact (Schedule.mean_rate), leak-off is Carter's law integrated exactly
-(:mod:`leakoff`), and the flux form conserves volume, so injected = stored + leaked to the Newton tolerance at
-every step.
+(:mod:`leakoff`), the flux form conserves volume and each accepted step's widths balance its volume exactly
+(newton.solve_step's volume-conserving shift), so injected = stored + leaked to round-off at every step.
 
 Start. The run starts at t0 from a radial fracture of radius R0 = ``initial_radius_cells`` cells around the
 injection cell's centre (the cells whose centres lie inside it; the grid is placed on the layer boundaries,
@@ -84,8 +84,8 @@ from ..io.progress import limit as show_limit
 from ..records import BalanceRecord
 from ..threads import blas_threads
 from .coarsen import coarse_grid, coarsen
-from .config import FractureNumerics
 from .elasticity import ElasticityOperator
+from .engine_setup import FractureEngineSetup, fracture_engine_setup
 from .engine_state import engine_state, restore_engine
 from .front import TipModel, edge_cells
 from .front_cells import CellFront
@@ -93,7 +93,7 @@ from .front_strategy import front_strategy
 from .interpolate import StepEnds
 from .leakoff import carter_demand, carter_volume
 from .lubrication import build_faces
-from .mesh import GROW, Grid, injection_cell_centre
+from .mesh import GROW, Grid
 from .newton import drained_start, Elasticity, NewtonWork, StepProblem, StepResult, solve_step, start_widths
 from .slurry import Slurry, held_tips
 from .solver_choice import use_dense
@@ -108,8 +108,8 @@ CLOSING_GROWTH = 1.0        # after a shut-in step in which cells closed, the ne
 
 
 def check_scene(scene) -> None:
-    """Reject what the engine cannot run before any work starts (also called by hfgpu.limits, so that
-    ``hfgpu check`` refuses it too)."""
+    """Reject what the engine cannot run before any work starts: called once per command by
+    hfgpu.limits.check_engine_start (``hfgpu check`` and ``hfgpu run`` validate a scene once)."""
     if scene.rock is None or scene.injection is None:
         raise SceneError("rock" if scene.rock is None else "injection", "(missing)",
                          "the fracture engine needs [rock] and [injection]")
@@ -161,20 +161,21 @@ class _Engine:
     """Mutable state of one run (grid fields, active-set systems, counters) and the implicit step on it; the
     front strategy (``front_tracking``) moves the front, views.py reports, engine_state.py checkpoints."""
 
-    def __init__(self, scene, numerics: FractureNumerics, slurry: Slurry | None = None):
-        self.scene, self.num, self.slurry = scene, numerics, slurry
+    def __init__(self, setup: FractureEngineSetup, slurry: Slurry | None = None):
+        self.setup, self.num, self.slurry = setup, setup.numerics, slurry
+        numerics = setup.numerics
         #: Extra normal stress [Pa] on the active cells (ix, iz), added to sigma_0 in each step's system (the
         #: shadow of the other planes and a cluster's offset, stage.py); None: none.
         self.stress_shift: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
-        rock, inj = scene.rock, scene.injection
-        self.dx, self.dz = scene.mesh.dx, scene.mesh.dz
+        rock = setup.rock
+        self.dx, self.dz = setup.mesh.dx, setup.mesh.dz
         self.area = self.dx * self.dz
         self.e_prime = rock.plane_strain_modulus
-        self.mu_prime = 12.0 * scene.fluid.viscosity
+        self.mu_prime = 12.0 * setup.viscosity
         mu_start = self.mu_prime   # the start (start_time, the tip) in the slurry at the perforation
         if slurry is not None:
-            mu_start *= float(slurry.at(*injection_cell_centre(scene))[0])
-        self.schedule = inj.schedule
+            mu_start *= float(slurry.at(*setup.source)[0])
+        self.schedule = setup.schedule
         self.tip = TipModel(self.e_prime, mu_start, numerics.tip_asymptote, numerics.tip_velocity)
         self.front_tracking = front_strategy(numerics.front_tracking)
         self.pumping = True   # the run starts while pumping (start_time); step() follows the schedule
@@ -182,10 +183,10 @@ class _Engine:
         h = max(self.dx, self.dz)
         r0 = numerics.initial_radius_cells * h
         half = int(math.ceil(r0 / min(self.dx, self.dz))) + GROW
-        self.grid = Grid.around_injection(self.dx, self.dz, *injection_cell_centre(scene), half)
+        self.grid = Grid.around_injection(self.dx, self.dz, *setup.source, half)
         self.load_properties()
-        k0 = K_PRIME_FACTOR * float(rock.toughness_at(np.array(inj.depth)))
-        c0 = 2.0 * float(rock.leakoff_at(np.array(inj.depth)))
+        k0 = K_PRIME_FACTOR * float(rock.toughness_at(np.array(setup.injection_depth)))
+        c0 = 2.0 * float(rock.leakoff_at(np.array(setup.injection_depth)))
         self.t0, power = start_time(self.schedule, self.e_prime, mu_start, k0, c0, r0)
         if self.t0 >= 0.5 * self.schedule.end or self.schedule.rate(self.t0) <= 0.0:
             raise SceneError("fracture.initial_radius_cells", numerics.initial_radius_cells,
@@ -234,7 +235,7 @@ class _Engine:
         x, z = self.grid.centres()
         self.ratio_box, self.blocked_box, self.floor_box = (None, None, None) if self.slurry is None \
             else self.slurry.at(x, z)
-        rock = self.scene.rock
+        rock = self.setup.rock
         self.sigma_box = rock.min_stress_at(z)
         self.kprime_box = K_PRIME_FACTOR * rock.toughness_at(z)
         self.cprime_box = 2.0 * rock.leakoff_at(z)
@@ -409,10 +410,10 @@ class _Engine:
         """Continue on a grid ``mesh.coarsening_factor`` times coarser (coarsen.coarse_grid: 3x3 merges, or
         PyFrac's 2x remeshing) once the footprint spans more than ``mesh.max_cells_across`` cells along x or z,
         with the front the strategy carries across (its ``carried_front``)."""
-        cap = self.scene.mesh.max_cells_across
+        cap = self.setup.mesh.max_cells_across
         if cap is None or max(np.ptp(self.ix), np.ptp(self.iz)) + 1 <= cap:
             return
-        c = coarsen(self.ix, self.iz, factor=self.scene.mesh.coarsening_factor)
+        c = coarsen(self.ix, self.iz, factor=self.setup.mesh.coarsening_factor)
         fill, advance = self.front_tracking.carried_front(self, c)
         self.grid = coarse_grid(self.grid, c, self.rows, self.cols, fill, advance)
         self.dx, self.dz = self.grid.dx, self.grid.dz
@@ -466,7 +467,7 @@ class _Engine:
         return engine_state(self)
 
     def restore(self, state: dict) -> None:
-        """Continue from a :meth:`state` (of a run of the same scene): same fields, same systems."""
+        """Continue from a :meth:`state` (of a run of the same setup): same fields, same systems."""
         restore_engine(self, state)
 
 
@@ -482,14 +483,12 @@ def closing_time(t_a: float, dt: float, w_start: np.ndarray, w_end: np.ndarray, 
     return t_a + dt * float(np.clip(share, 0.0, 1.0).max())
 
 
-def _times(scene, t0: float) -> tuple[list[float], list[float]]:
+def _step_times(setup: FractureEngineSetup, t0: float) -> tuple[list[float], list[float]]:
     """(times steps must land on, output times), both sorted: the schedule's breakpoints and the end (physics),
-    and every ``output.every`` and the end, after t0."""
-    end = scene.run.end_time
-    every = scene.output.every
-    outputs = {every * k for k in range(1, int(math.floor(end / every + 1e-9)) + 1)} | {end}
-    breaks = {b for b in scene.injection.schedule.breakpoints() if t0 < b < end}
-    return sorted(breaks | {end}), sorted(t for t in outputs if t0 < t <= end)
+    and the setup's output times, after t0."""
+    end = setup.end_time
+    breaks = {b for b in setup.schedule.breakpoints() if t0 < b < end}
+    return sorted(breaks | {end}), [t for t in setup.output_times if t > t0]
 
 
 def _landed(output: float, t: float) -> bool:
@@ -500,16 +499,18 @@ def _landed(output: float, t: float) -> bool:
 class FractureRun:
     """One run of the engine driven to a time (a :class:`hfgpu.engines.FractureEngine`): ``advance(until)`` steps
     it there (landing a step on it), so a caller can hand it a slurry between calls (``use_slurry``, the two-way
-    coupled loop of hfgpu.coupled); :func:`simulate` advances it to the end at once. Arguments as
-    :func:`simulate`'s, plus the ``slurry`` it starts in (fracture/slurry.py; None: clean fluid)."""
+    coupled loop of hfgpu.coupled); :func:`simulate` advances it to the end at once. It takes the engine's
+    setup (engine_setup.py, of a scene validated before it: hfgpu.scene_checks.validate; it checks nothing
+    itself), the sink, ``progress``, ``checkpoint`` and ``resume`` as :func:`simulate`, and the ``slurry`` it
+    starts in (fracture/slurry.py; None: clean fluid)."""
 
-    def __init__(self, scene, sink, progress: Callable[[float], None] | None = None, checkpoint=None,
-                 resume: dict | None = None, slurry: Slurry | None = None):
-        check_scene(scene)
-        numerics = scene.fracture if scene.fracture is not None else FractureNumerics()
+    def __init__(self, setup: FractureEngineSetup, sink, progress: Callable[[float], None] | None = None,
+                 checkpoint=None, resume: dict | None = None, slurry: Slurry | None = None):
+        numerics = setup.numerics
+        self.setup = setup
         self.sink, self.progress, self.checkpoint = sink, progress, checkpoint
-        self.engine = eng = _Engine(scene, numerics, slurry)
-        self.targets, self.outputs = _times(scene, eng.t0)
+        self.engine = eng = _Engine(setup, slurry)
+        self.targets, self.outputs = _step_times(setup, eng.t0)
         self.dt = numerics.time_step_relaxation * min(eng.dx, eng.dz) / eng.v_front
         self.index = 0   # the step target being approached
         if resume is not None:
@@ -583,7 +584,8 @@ class FractureRun:
 
 def simulate(scene, sink, progress: Callable[[float], None] | None = None, checkpoint=None,
              resume: dict | None = None, slurry: Slurry | None = None) -> dict:
-    """Run the planar-3D fracture model of ``scene`` to ``run.end_time`` (paper sections 2.2, 3.1).
+    """Run the planar-3D fracture model of ``scene`` to ``run.end_time`` (paper sections 2.2, 3.1): a
+    :class:`FractureRun` of its setup (engine_setup.fracture_engine_setup).
 
     Calls ``sink.fracture_balance(BalanceRecord)`` after every accepted step and
     ``sink.fracture_snapshot(FractureSnapshot)`` at every ``output.every`` and at the end; ``progress(t)``
@@ -604,6 +606,6 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
     same steps as an uninterrupted run and the snapshots after t. ``slurry`` (fracture/slurry.py): the run in
     that slurry throughout (None: the clean fluid).
     """
-    run = FractureRun(scene, sink, progress, checkpoint, resume, slurry)
-    run.advance(scene.run.end_time)
+    run = FractureRun(fracture_engine_setup(scene), sink, progress, checkpoint, resume, slurry)
+    run.advance(run.setup.end_time)
     return run.summary()

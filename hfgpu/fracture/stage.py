@@ -35,16 +35,19 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
 from ..perforations import Entry, split_rate
 from ..records import BalanceRecord, StageRecord, StageSnapshot
-from .config import FractureNumerics
+from .engine_setup import FractureEngineSetup, fracture_engine_setup
 from .shadow import PlanesOperator
-from .simulator import _Engine, _landed, _times, MIN_STEP_FRACTION, check_scene
+from .simulator import _Engine, _landed, _step_times, MIN_STEP_FRACTION
 from .views import front_extents, geometry, snapshot
+
+if TYPE_CHECKING:
+    from ..completion import Completion
 
 #: Relative tolerance of the stage iteration (module docstring).
 STAGE_TOLERANCE = 1e-3
@@ -85,18 +88,16 @@ class ClusterInlet:
 class StageEngine:
     """The planes of a stage and the coupled step (module docstring)."""
 
-    def __init__(self, scene, numerics: FractureNumerics):
-        completion = scene.completion
+    def __init__(self, setup: FractureEngineSetup, completion: Completion, density: float):
         n = completion.clusters
-        self.pump = scene.injection.schedule
+        self.pump = setup.schedule
         self.inlets = [ClusterInlet(self.pump, 1.0 / n) for _ in range(n)]
-        self.planes = [_Engine(scene.replace(injection=dataclasses.replace(scene.injection, schedule=inlet)),
-                               numerics) for inlet in self.inlets]
+        self.planes = [_Engine(dataclasses.replace(setup, schedule=inlet)) for inlet in self.inlets]
         first = self.planes[0]
         self.t0 = self.t = first.t0
         for inlet in self.inlets:   # the starting fractures hold Q t0 / N each
             inlet.commit(self.t0)
-        self.coefficients = completion.entry_coefficients(scene.fluid.density)
+        self.coefficients = completion.entry_coefficients(density)
         self.offsets = completion.offsets()
         self.operator = PlanesOperator(first.dx, first.dz, first.e_prime, completion.positions)
         self.sources = [self._widths(plane) for plane in self.planes]
@@ -278,12 +279,18 @@ def simulate(scene, sink, progress: Callable[[float], None] | None = None, check
     Checkpoints as simulator.simulate's: ``checkpoint.save(t, {"stage": StageEngine.state(), "dt": next step,
     "target": index of the step target})`` after the first step past each interval; ``resume`` continues from
     such a state."""
-    check_scene(scene)
-    numerics = scene.fracture if scene.fracture is not None else FractureNumerics()
-    stage = StageEngine(scene, numerics)
+    return run(fracture_engine_setup(scene), scene.completion, scene.fluid.density, sink, progress, checkpoint,
+               resume)
+
+
+def run(setup: FractureEngineSetup, completion: Completion, density: float, sink,
+        progress: Callable[[float], None] | None = None, checkpoint=None, resume: dict | None = None) -> dict:
+    """:func:`simulate` of a stage given as its planes' engine setup (``schedule`` the pump's), its completion and
+    the fluid density [kg/m^3] (the perforation friction's)."""
+    stage = StageEngine(setup, completion, density)
     first = stage.planes[0]
-    targets, outputs = _times(scene, stage.t0)
-    dt = numerics.time_step_relaxation * min(first.dx, first.dz) / first.v_front
+    targets, outputs = _step_times(setup, stage.t0)
+    dt = setup.numerics.time_step_relaxation * min(first.dx, first.dz) / first.v_front
     index = 0
     if resume is not None:
         stage.restore(resume["stage"])

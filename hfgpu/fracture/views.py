@@ -66,7 +66,7 @@ def front_extents(engine, view: View) -> dict:
     left and right (module docstring)."""
     g, dx, dz = view.grid, view.grid.dx, view.grid.dz
     xo, zo = g.offsets()
-    zo = zo + (g.z_inj - engine.scene.injection.depth)   # the injection cell's centre is up to dz/2 off it (mesh.py)
+    zo = zo + (g.z_inj - engine.setup.injection_depth)   # the injection cell's centre is up to dz/2 off it (mesh.py)
     tips, nx, nz = engine.front_tracking.tip_normals(engine, view)
     if tips.any():
         px, pz = (xo + g["advance"] * nx)[tips], (zo + g["advance"] * nz)[tips]

@@ -270,14 +270,3 @@ def limit(progress: Any, dt: float, reason: str) -> None:
     """``progress.limit(dt, reason)`` when the engine's ``progress`` callable has it (:meth:`Progress.limit`)."""
     if hasattr(progress, "limit"):
         progress.limit(dt, reason)
-
-
-def shifted(progress: Callable[[float], None], offset: float) -> Callable[[float], None]:
-    """``progress`` for an engine whose clock starts at ``offset`` [s] of the run's: ``t -> progress(t + offset)``,
-    passing :func:`note` and :func:`limit` on."""
-    def call(t: float) -> None:
-        progress(t + offset)
-
-    call.note = lambda text: note(progress, text)  # type: ignore[attr-defined]
-    call.limit = lambda dt, reason: limit(progress, dt, reason)  # type: ignore[attr-defined]
-    return call

@@ -44,15 +44,13 @@ KEYS = {"dt_max": "[mppic] dt_max", "output": "[output] every or the schedule's 
 
 @dataclass
 class Watch:
-    """The checks of the module docstring for one run. ``offset`` [s] moves times onto the scene's clock (the
-    coupled run's proppant phase starts at the end of the pad); ``units`` is the scene's output system;
-    ``stride`` > 0: the grid holds a stage's clusters side by side every ``stride`` columns (hfgpu.stage_blocks),
-    and a cell is named by its cluster and its x on that cluster's plane."""
+    """The checks of the module docstring for one run (times on the scene's clock); ``units`` is the scene's
+    output system; ``stride`` > 0: the grid holds a stage's clusters side by side every ``stride`` columns
+    (hfgpu.stage_blocks), and a cell is named by its cluster and its x on that cluster's plane."""
 
     theta_cp: float
     smallest_grain: float
     units: str = "SI"
-    offset: float = 0.0
     stride: int = 0
     found: dict[str, str] = field(default_factory=dict)
 
@@ -70,7 +68,7 @@ class Watch:
     def _report(self, kind: str, t: float, text: str) -> None:
         if kind in self.found:
             return
-        line = f"{kind} at t = {format_number(t + self.offset)} s: {text}"
+        line = f"{kind} at t = {format_number(t)} s: {text}"
         self.found[kind] = line
         warnings.warn(line, RuntimeWarning, stacklevel=3)
 
@@ -103,7 +101,7 @@ class Watch:
         text = (f"step {dt:.3g} s against {nominal:.3g} s, bounded by the {bound} ({KEYS[bound]}); "
                 + self.fastest(frame, fast_cell(), width, theta))
         if dt < COLLAPSE_FLOOR * nominal:
-            raise SimulationError(f"the proppant step collapsed: {text}", time=t + self.offset)
+            raise SimulationError(f"the proppant step collapsed: {text}", time=t)
         self._report("collapsing step", t, text)
 
     def fastest(self, frame, cell: tuple[int, int], width: np.ndarray, theta: np.ndarray) -> str:

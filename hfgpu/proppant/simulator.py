@@ -59,7 +59,8 @@ from ..errors import SimulationError
 from ..io.progress import limit as show_limit, note
 from ..io.sink import ProppantSink
 from ..records import GridFrame, ProppantSnapshot, SolidBalanceRecord
-from .config import Geometry, Port, ProppantSetup
+from .config import Geometry
+from .engine_setup import ProppantEngineSetup, proppant_engine_setup
 from .engine import make_engine
 from .engine_seam import ParticleEngine
 from .fluid import CourantLimitExceeded, FluidNumerics, FluidSolver, FluidState, courant_rates
@@ -74,54 +75,67 @@ FLUID_VOLUMES = ("injected", "opened", "supplied", "stored", "leaked", "outflow"
 WidthField = Callable[[float], "tuple[np.ndarray, np.ndarray]"]
 
 
-def build_grid(geometry: Geometry, mesh) -> StaggeredGrid:
+def build_grid(geometry: Geometry, dx: float, dz: float) -> StaggeredGrid:
     """The staggered grid of a geometry: box/slot with round(length/dx) x round(height/dz) cells (the cell
     size adjusted to fit exactly), field on the width file's own grid."""
     if geometry.kind == "field":
         x, z = geometry.field_x, geometry.field_z
         frame = GridFrame(dx=float(x[1] - x[0]), dz=float(z[1] - z[0]), x0=float(x[0]), z0=float(z[0]))
         return StaggeredGrid.from_width(frame, geometry.field_w)
-    nz, nx = box_shape(geometry, mesh)
+    nz, nx = box_shape(geometry, dx, dz)
     return StaggeredGrid.box(geometry.length, geometry.height, geometry.width, nx, nz)
 
 
-def box_shape(geometry: Geometry, mesh) -> tuple[int, int]:
+def box_shape(geometry: Geometry, dx: float, dz: float) -> tuple[int, int]:
     """(nz, nx) of a box or slot grid: round(height / dz) x round(length / dx) cells, at least one each."""
-    return max(1, round(geometry.height / mesh.dz)), max(1, round(geometry.length / mesh.dx))
+    return max(1, round(geometry.height / dz)), max(1, round(geometry.length / dx))
 
 
-def particles_per_parcel(setup: ProppantSetup, schedule, cell_volume: float) -> list[float]:
-    """Real particles per parcel of each class: the scene's value, or so that ``parcels_per_cell`` parcels
-    fill a cell of volume ``cell_volume`` at the class's largest volume fraction (initial or injected); with
-    ``max_parcels`` (MppicNumerics), raised by one common factor where the schedule's proppant would make more
-    parcels than that (n_c = V_c / (ppp_c v_c) summed over the classes, V_c the class's scheduled solid volume,
-    v_c its mean particle volume)."""
+def particles_per_parcel(setup, schedule, cell_volume: float, start: float = 0.0) -> list[float]:
+    """Real particles per parcel of each class (``setup``: the scene's ProppantSetup or a ProppantEngineSetup,
+    their ``classes`` and ``numerics``): the scene's value, or so that ``parcels_per_cell`` parcels fill a cell of
+    volume ``cell_volume`` at the class's largest volume fraction (initial or injected from ``start`` on); with
+    ``max_parcels`` (MppicNumerics), raised by one common factor where the schedule's proppant from ``start`` on
+    would make more parcels than that (n_c = V_c / (ppp_c v_c) summed over the classes, V_c the class's solid
+    volume scheduled after ``start``, v_c its mean particle volume)."""
     numerics = setup.numerics
     if numerics.particles_per_parcel is not None:
         return [numerics.particles_per_parcel] * len(setup.classes)
     out, parcels = [], 0.0
     for cls in setup.classes:
         fraction = cls.initial_volume_fraction
-        for stage in (schedule.stages if schedule is not None else ()):
+        for begin, first, stage in _stages_after(schedule, start):
             if stage.proppant == cls.name:
-                fraction = max(fraction, stage.volume_fraction, stage.end_volume_fraction)
+                fraction = max(fraction, stage.fraction_at(first, begin), stage.end_volume_fraction)
         ppp = fraction * cell_volume / (numerics.parcels_per_cell * cls.size.mean_particle_volume())
         ppp = ppp if ppp > 0.0 else 1.0
         out.append(ppp)
-        parcels += scheduled_solid_volume(schedule, cls.name) / (ppp * cls.size.mean_particle_volume())
+        parcels += scheduled_solid_volume(schedule, cls.name, start) / (ppp * cls.size.mean_particle_volume())
     if numerics.max_parcels is not None and parcels > numerics.max_parcels:
         out = [ppp * parcels / numerics.max_parcels for ppp in out]
     return out
 
 
-def scheduled_solid_volume(schedule, name: str) -> float:
-    """Solid volume [m^3] the schedule injects of proppant class ``name``: sum of Q T (f0 + f1) / 2 over its
-    stages (the slurry rate Q, the volume fraction ramped linearly from f0 to f1)."""
-    total, start = 0.0, 0.0
+def _stages_after(schedule, start: float) -> list[tuple[float, float, object]]:
+    """(the stage's start, the later of it and ``start``, the stage) of each stage of ``schedule`` (None: none)
+    that ends after ``start``."""
+    out, begin = [], 0.0
     for stage in (schedule.stages if schedule is not None else ()):
+        if stage.until > start:
+            out.append((begin, max(begin, start), stage))
+        begin = stage.until
+    return out
+
+
+def scheduled_solid_volume(schedule, name: str, start: float = 0.0) -> float:
+    """Solid volume [m^3] the schedule injects of proppant class ``name`` after ``start``: sum of Q T (f0 + f1) / 2
+    over its stages from ``start`` on (the slurry rate Q, the volume fraction ramped linearly from f0 at the
+    stage's start, or at ``start`` within it, to f1)."""
+    total = 0.0
+    for begin, first, stage in _stages_after(schedule, start):
         if stage.proppant == name:
-            total += stage.rate * (stage.until - start) * 0.5 * (stage.volume_fraction + stage.end_volume_fraction)
-        start = stage.until
+            total += stage.rate * (stage.until - first) * 0.5 * (stage.fraction_at(first, begin)
+                                                                 + stage.end_volume_fraction)
     return total
 
 
@@ -148,23 +162,25 @@ class ProppantSimulation:
     injected + opened + supplied = stored + leaked + outflow; ``supplied``: what a width history
     inconsistent with the injection needed beyond it, hfgpu.proppant.fluid.StepInfo), ``seconds`` (wall time [s]
     of the fluid steps, "fluid", and of the parcel sub-loops, "parcels", retries included). ``add_parcels``
-    places extra parcels (counted as injected), e.g. a single test particle. ``inlet_split(t0, t1)`` (optional)
+    places extra parcels (counted as injected), e.g. a single test particle.
+
+    It takes the engine's setup (engine_setup.py) and keeps the scene's clock: ``time`` starts at the setup's
+    ``start``, and every record and message carries the scene's time. ``width_field(t) -> (width, leakoff)``
+    (optional) drives the grid's width and leak-off at the scene's time t; ``inlet_split(t0, t1)`` (optional)
     splits the slurry rate among the inlets over a step (hfgpu.proppant.injection.Injector ``split``).
     """
 
-    def __init__(self, scene, width_field: WidthField | None = None, inlet_split=None):
-        setup: ProppantSetup = scene.proppant
-        self.scene = scene
+    def __init__(self, setup: ProppantEngineSetup, width_field: WidthField | None = None, inlet_split=None):
         self.setup = setup
         self.params = setup.params
         self.numerics = setup.numerics
-        self.rho_f = scene.fluid.density
-        self.mu_f = scene.fluid.viscosity
+        self.rho_f = setup.fluid.density
+        self.mu_f = setup.fluid.viscosity
         self.width_field = width_field
-        self.grid = build_grid(setup.geometry, scene.mesh)
+        self.grid = build_grid(setup.geometry, *setup.cell_size)
         self.leakoff = np.zeros(self.grid.shape)
         if width_field is not None:
-            self._set_width(0.0)
+            self._set_width(setup.start)
         self.outlets = np.zeros(self.grid.shape, dtype=bool)
         for k, i in ports_to_cells(setup.geometry.outlets, self.grid.frame, self.grid.width,
                                    "geometry.outlets"):
@@ -172,12 +188,12 @@ class ProppantSimulation:
         self.engine: ParticleEngine = make_engine(self.numerics.backend, self.grid, self.params, self.rho_f,
                                                   self.mu_f, self.numerics.gravity, self.outlets,
                                                   arch=self.numerics.arch)
-        self.time = 0.0
+        self.time = setup.start
         self.seconds = {"fluid": 0.0, "parcels": 0.0}
-        self.rng = np.random.default_rng(scene.run.seed)
+        self.rng = np.random.default_rng(setup.seed)
         open_volume = self.grid.cell_volume[self.grid.active]
-        schedule = scene.injection.schedule if scene.injection is not None else None
-        self.particles_per_parcel = particles_per_parcel(setup, schedule, float(np.median(open_volume)))
+        schedule = setup.schedule
+        self.particles_per_parcel = particles_per_parcel(setup, schedule, float(np.median(open_volume)), setup.start)
         self.injected = 0.0
         self.outflow = 0.0
         self.screen_out_time = math.nan  # start of the first step whose inlets held proppant back
@@ -196,27 +212,25 @@ class ProppantSimulation:
         self.steps = 0
         self.safety = 1.0
         self.limited_by = "dt_max"
-        self.watch = Watch(self.params.theta_cp, min(c.size.d_min for c in setup.classes), scene.output.units)
+        self.watch = Watch(self.params.theta_cp, min(c.size.d_min for c in setup.classes), setup.units)
         self.fluid_totals = dict.fromkeys(FLUID_VOLUMES, 0.0)
-        self.next_out = 0.0       # the next snapshot's time (run, advance)
+        self.next_out = setup.start   # the next snapshot's time (run, advance)
         self.max_residual = 0.0   # the largest continuity residual of the steps so far
 
     # -- set-up ---------------------------------------------------------------------------------------
 
     def _make_injector(self, schedule, split) -> Injector | None:
-        ports = self.setup.geometry.inlets
         if schedule is None:
             return None
-        if not ports:
-            ports = (Port("point", x=self.scene.injection.x, depth=self.scene.injection.depth),)
         names = [c.name for c in self.setup.classes]
 
         def loadings(t: float) -> list[tuple[int, float]]:
             name, fraction = schedule.proppant_fraction(t)
             return [] if name is None else [(names.index(name), fraction)]
 
-        return Injector(ports, self.grid.frame, self.grid.width, self.setup.classes, self.particles_per_parcel,
-                        rate=schedule.mean_rate, loadings=loadings, rng=self.rng, split=split)
+        return Injector(self.setup.geometry.inlets, self.grid.frame, self.grid.width, self.setup.classes,
+                        self.particles_per_parcel, rate=schedule.mean_rate, loadings=loadings, rng=self.rng,
+                        split=split)
 
     def _set_width(self, t: float) -> None:
         width, leakoff = self.width_field(t)
@@ -280,7 +294,7 @@ class ProppantSimulation:
                 self.solver.set_grid(self.grid)
                 self.engine.set_grid(self.grid)
             if not (dt > 0.0 and t0 + dt > t0):
-                raise SimulationError(f"zero-length time step (dt = {dt:g} s)", time=t0 + self.watch.offset)
+                raise SimulationError(f"zero-length time step (dt = {dt:g} s)", time=t0)
             self.engine.begin_step(self.fluid.u, self.fluid.v, self.fluid.p)
             if self.injector is not None:
                 self._inject(t0, t0 + dt)
@@ -310,7 +324,7 @@ class ProppantSimulation:
                                        self.moments.volume_fraction)
             raise SimulationError(f"the fluid Courant number stayed above c_max = {self.numerics.c_max:g} "
                                   f"after {self.numerics.max_step_retries} reductions of the step "
-                                  f"({KEYS['fluid Courant']}); {where}", time=t0 + self.watch.offset)
+                                  f"({KEYS['fluid Courant']}); {where}", time=t0)
         self.engine.commit()
         self.outflow += loop.outflow
         self.fluid = trial
@@ -368,7 +382,7 @@ class ProppantSimulation:
             bad = ~np.isfinite(values)
             if bad.any():
                 cell = tuple(int(c) for c in np.argwhere(bad)[0])
-                raise SimulationError(f"non-finite fluid {name}", time=t + self.watch.offset, cell=cell)
+                raise SimulationError(f"non-finite fluid {name}", time=t, cell=cell)
 
     # -- records --------------------------------------------------------------------------------------
 
@@ -388,8 +402,8 @@ class ProppantSimulation:
 
     def run(self, sink: ProppantSink, progress: Callable[[float], None] | None = None,
             on_step: Callable[[StepInfo], None] | None = None, checkpoint=None, resume: dict | None = None) -> dict:
-        """Step to the scene's end time, writing snapshots every ``output.every`` (and at 0 and the end) and
-        a balance record every step; returns a summary.
+        """Step to the end time, writing snapshots every ``output_every`` (and at the start and the end) and a
+        balance record every step; returns a summary.
 
         Checkpoints (hfgpu.io.checkpoint): after the first step that ends at or past each interval,
         ``checkpoint.save(time, state)`` gets {"simulation": :meth:`state`, "next_out", "max_residual"};
@@ -397,18 +411,17 @@ class ProppantSimulation:
         if resume is not None:
             self.restore(resume["simulation"])
             self.next_out, self.max_residual = resume["next_out"], resume["max_residual"]
-        self.advance(self.scene.run.end_time, sink, progress, on_step, checkpoint)
+        self.advance(self.setup.end_time, sink, progress, on_step, checkpoint)
         return self.finish(sink)
 
     def advance(self, until: float, sink: ProppantSink, progress: Callable[[float], None] | None = None,
                 on_step: Callable[[StepInfo], None] | None = None, checkpoint=None) -> None:
         """Step to ``until`` (a step lands on it), writing the snapshots due and a balance record every step
         (:meth:`run`; the two-way coupled loop of hfgpu.coupled calls it interval by interval)."""
-        end = self.scene.run.end_time
-        every = self.scene.output.every
-        breaks = sorted(b for b in (self.scene.injection.schedule.breakpoints()
-                                    if self.scene.injection is not None else ()) if 0.0 < b < end)
-        eps = 1e-9 * end
+        start, end, every = self.setup.start, self.setup.end_time, self.setup.output_every
+        breaks = sorted(b for b in (self.setup.schedule.breakpoints() if self.setup.schedule is not None else ())
+                        if start < b < end)
+        eps = 1e-9 * (end - start)
         while True:
             if self.time >= self.next_out - eps:
                 sink.proppant_snapshot(self.snapshot())
@@ -432,7 +445,7 @@ class ProppantSimulation:
 
     def finish(self, sink: ProppantSink) -> dict:
         """The last snapshot (unless one was just written) and the run's summary (:meth:`run`)."""
-        if abs(self.time - (self.next_out - self.scene.output.every)) > 1e-9 * self.scene.run.end_time:
+        if abs(self.time - (self.next_out - self.setup.output_every)) > 1e-9 * (self.setup.end_time - self.setup.start):
             sink.proppant_snapshot(self.snapshot())
         record = self.balance()
         return dict(time=self.time, steps=self.steps, parcels=self.engine.live, injected=record.injected,
@@ -466,7 +479,7 @@ class ProppantSimulation:
         return state
 
     def restore(self, state: dict) -> None:
-        """Continue from a :meth:`state` (of a simulation of the same scene, freshly built)."""
+        """Continue from a :meth:`state` (of a simulation of the same setup, freshly built)."""
         for name in self.STATE_ATTRIBUTES:
             setattr(self, name, np.array(state[name]) if isinstance(state[name], np.ndarray) else state[name])
         self.fluid_totals = {name: float(state["fluid_totals"][name]) for name in FLUID_VOLUMES}
@@ -488,13 +501,12 @@ class ProppantSimulation:
         self.moments = self.engine.moments()
 
 
-def warn_screen_out(summary: dict, theta_cp: float, offset: float = 0.0) -> None:
-    """A RuntimeWarning line when a run's inlets held proppant back (``summary`` of :meth:`ProppantSimulation.run`;
-    ``offset`` moves its times onto the caller's clock)."""
+def warn_screen_out(summary: dict, theta_cp: float) -> None:
+    """A RuntimeWarning line when a run's inlets held proppant back (``summary`` of :meth:`ProppantSimulation.run`)."""
     if summary["screened_out"] > 0.0:
         warnings.warn(f"screen-out: the inlets held back {summary['screened_out']:.4g} m^3 of proppant "
                       f"({100 * summary['screened_out'] / summary['injected']:.1f} % of the injected solids), "
-                      f"first at t = {summary['screen_out_time'] + offset:g} s: their cells were packed to "
+                      f"first at t = {summary['screen_out_time']:g} s: their cells were packed to "
                       f"theta_cp = {theta_cp:g} or narrower than the largest grain", RuntimeWarning, stacklevel=3)
 
 
@@ -508,7 +520,7 @@ def simulate(scene, sink: ProppantSink, progress: Callable[[float], None] | None
     (time, steps, parcels, injected, in_domain, outflow, screened_out, screen_out_time (NaN when none),
     max_continuity_residual, backend). ``checkpoint``, ``resume``: see :meth:`ProppantSimulation.run`.
     """
-    summary = ProppantSimulation(scene, width_field=width_field).run(sink, progress, checkpoint=checkpoint,
-                                                                     resume=resume)
+    sim = ProppantSimulation(proppant_engine_setup(scene), width_field=width_field)
+    summary = sim.run(sink, progress, checkpoint=checkpoint, resume=resume)
     warn_screen_out(summary, scene.proppant.params.theta_cp)
     return summary

@@ -133,6 +133,7 @@ def test_a_sub_grid_front_hands_over_to_whole_cells_and_closes():
     "Closure"); the fracture closes within the same Carter bounds as the whole-cell front's, the balance stays
     exact, and a checkpoint taken after the hand-over resumes with whole cells. Measured: 969 s against the
     whole-cell front's 721 s (606 s at steps growing 1.05x: docs/benchmarks.md)."""
+    from hfgpu.fracture.engine_setup import fracture_engine_setup
     from hfgpu.fracture.simulator import _Engine
 
     scene = load_scene(SCENE.format(end="3000 s", c_l=C_L, schedule=PUMP + ', { until = "3000 s", rate = "0 m**3/s" }',
@@ -154,7 +155,7 @@ def test_a_sub_grid_front_hands_over_to_whole_cells_and_closes():
 
     simulate(scene, MemorySink(), checkpoint=Keep())
     state = next(s for s in states if math.isfinite(s["engine"]["t_receding"]))
-    engine = _Engine(scene, scene.fracture)
+    engine = _Engine(fracture_engine_setup(scene))
     engine.restore(state["engine"])
     assert engine.front_tracking.name == "cells"
 

@@ -4,6 +4,7 @@ naming a cell height that puts it there; scenes without layers, or already on fa
 
 from __future__ import annotations
 
+import dataclasses
 import subprocess
 import sys
 
@@ -12,6 +13,7 @@ import pytest
 
 from hfgpu.fracture.config import FractureNumerics
 from hfgpu.fracture.mesh import fit_layers, injection_cell_centre, layer_boundaries, scene_layer_fit
+from hfgpu.fracture.engine_setup import fracture_engine_setup
 from hfgpu.fracture.simulator import _Engine
 from hfgpu.scene import load_scene
 from hfgpu.scene_checks import validate
@@ -68,7 +70,7 @@ def five(refinement: float) -> str:
 def rows_of(text: str):
     """(top face, bottom face, stress at the row's centre in the engine) of every row of the engine's first grid."""
     sc = load_scene(text)
-    eng = _Engine(sc, FractureNumerics())
+    eng = _Engine(dataclasses.replace(fracture_engine_setup(sc), numerics=FractureNumerics()))
     _, z = eng.grid.centres()
     centre = z[:, 0]
     return sc, centre - 0.5 * eng.dz, centre + 0.5 * eng.dz, eng.sigma_box[:, 0], eng

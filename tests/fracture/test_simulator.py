@@ -95,9 +95,12 @@ min_stress = "8 MPa"
 
 
 def test_bad_input_is_rejected_before_work_starts():
+    """A first stage that does not inject is refused by the scene's validation (hfgpu run and hfgpu check validate
+    once; the engine checks nothing itself); the starting fracture's size by the engine's start."""
+    from hfgpu.scene_checks import validate
+
     with pytest.raises(SceneError, match=r"injection.schedule\[0\].rate"):
-        simulate(scene(schedule='[{ until = "10 s", rate = "0 m**3/s" }, { until = "100 s", rate = "1e-3 m**3/s" }]'),
-                 MemorySink())
+        validate(scene(schedule='[{ until = "10 s", rate = "0 m**3/s" }, { until = "100 s", rate = "1e-3 m**3/s" }]'))
     with pytest.raises(SceneError, match="fracture.tip_asymptote"):
         load_scene(scene_text(fracture='[fracture]\ntip_asymptote = "magic"'))
     with pytest.raises(SceneError, match="fracture.tip_velocity"):

@@ -9,6 +9,7 @@ stop with a clear error before any work.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import signal
 import subprocess
@@ -226,6 +227,25 @@ def test_coupled_run_resumes_in_either_phase(after, phase, reference, tmp_path, 
         assert got[key] == ref[key], key
 
 
+def test_a_coupled_checkpoint_on_the_proppant_clock_resumes(reference, tmp_path, monkeypatch):
+    """A proppant-phase checkpoint without ``clock`` holds its proppant times counted from the proppant start (as
+    files were written while the proppant engine's clock started at 0): it resumes with them moved onto the
+    scene's clock (hfgpu.coupled._on_scene_clock), as the uninterrupted run (to round-off: t - 20 + 20 s)."""
+    path = tmp_path / "coupled.h5"
+    _interrupted(monkeypatch, COUPLED, path, 15, 3)
+    start = open_results(reference["coupled"]).summary["proppant_start"]
+    with h5py.File(path, "r+", locking=False) as f:
+        state = f["checkpoint/state"]
+        assert state.attrs["phase"] == "proppant" and state.attrs["clock"] == "scene"
+        del state.attrs["clock"]
+        state["proppant"].attrs["next_out"] -= start
+        for name in ("time", "screen_out_time"):
+            state["proppant/simulation"].attrs[name] -= start
+    hfgpu.run(load_scene(COUPLED), path, progress=False, resume=True)
+    _assert_same_results(reference["coupled"], path, rtol=1e-9)
+    assert open_results(path).summary["proppant_steps"] == open_results(reference["coupled"]).summary["proppant_steps"]
+
+
 #: COUPLED as a stage of two clusters 30 m apart (hfgpu.coupled_stage), twice the rate.
 STAGE = COUPLED.replace('rate = "2e-3 m**3/s"', 'rate = "4e-3 m**3/s"') + '[completion]\nclusters = 2\nspacing = "30 m"\n'
 
@@ -343,15 +363,16 @@ def _assert_same_tree(a: dict, b: dict, path: str = "") -> None:
 
 def test_fracture_engine_state_round_trip(tmp_path):
     from hfgpu.fracture.config import FractureNumerics
+    from hfgpu.fracture.engine_setup import fracture_engine_setup
     from hfgpu.fracture.simulator import _Engine
 
-    scene = load_scene(FRACTURE)
-    engine = _Engine(scene, FractureNumerics())
+    setup = dataclasses.replace(fracture_engine_setup(load_scene(FRACTURE)), numerics=FractureNumerics())
+    engine = _Engine(setup)
     dt = 0.5
     for _ in range(6):
         dt = engine.next_dt(engine.step(dt))
     state = engine.state()
-    other = _Engine(scene, FractureNumerics())
+    other = _Engine(setup)
     other.restore(_through_hdf5(tmp_path, state))
     _assert_same_tree(state, other.state())
     for _ in range(4):  # and both go on alike
@@ -362,15 +383,16 @@ def test_fracture_engine_state_round_trip(tmp_path):
 
 
 def test_proppant_simulation_state_round_trip(tmp_path):
+    from hfgpu.proppant.engine_setup import proppant_engine_setup
     from hfgpu.proppant.simulator import ProppantSimulation
 
     scene = load_scene(PROPPANT)
-    sim = ProppantSimulation(scene)
+    sim = ProppantSimulation(proppant_engine_setup(scene))
     for _ in range(8):
         sim.step(limit=0.3 - sim.time)
     state = sim.state()
     assert sim.parcels.n > 0 and state["linear"]["data"].size > 0  # an LU to carry over
-    other = ProppantSimulation(scene)
+    other = ProppantSimulation(proppant_engine_setup(scene))
     other.restore(_through_hdf5(tmp_path, state))
     _assert_same_tree(state, other.state())
     for _ in range(5):  # new parcels drawn from the restored generator, the same LU reused

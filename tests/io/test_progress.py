@@ -9,7 +9,7 @@ import threading
 import time
 
 import pytest
-from hfgpu.io.progress import PLAIN_EVERY, Progress, limit, note, shifted
+from hfgpu.io.progress import PLAIN_EVERY, Progress, limit, note
 
 
 class Clock:
@@ -96,12 +96,11 @@ def test_engines_report_through_any_progress_callable():
     note(calls.append, "compiling kernels")  # a plain callable: nothing happens
     limit(None, 0.1, "dt_max")
     bar = Progress(100.0, enabled=False, clock=Clock())
-    bar.phase("proppant", 20.0)
-    engine = shifted(bar, 20.0)  # the proppant engine's clock starts at 20 s of the run's
-    note(engine, "compiling kernels")
+    bar.phase("proppant", 20.0)   # the proppant engine's clock is the run's: its phase starts at 20 s
+    note(bar, "compiling kernels")
     assert bar._extra()["postfix"] == "compiling kernels"
-    limit(engine, 5.0, "coupling interval")
-    engine(5.0)
+    limit(bar, 5.0, "coupling interval")
+    bar(25.0)
     assert bar.time == 25.0 and bar._extra()["postfix"] == "dt 5 s (coupling interval)"
     bar.close()
     assert calls == []

@@ -10,6 +10,7 @@ import pytest
 
 from hfgpu import load_scene
 from hfgpu.proppant.analysis import row_profile
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
 BOX = """
@@ -40,8 +41,8 @@ parcels_per_cell = 12
 
 
 def settle(text: str) -> ProppantSimulation:
-    sim = ProppantSimulation(load_scene(text))
-    end = sim.scene.run.end_time
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(text)))
+    end = sim.setup.end_time
     while sim.time < end - 1e-9:
         sim.step(limit=end - sim.time)
     return sim

@@ -24,6 +24,7 @@ from hfgpu import load_scene
 from hfgpu.kernels.closures import bed
 from hfgpu.kernels.closures.wall_friction import wall_friction_code
 from hfgpu.proppant.parcels import Parcels
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
 L, H, W, DZ, ROWS = 0.10, 0.04, 5e-3, 5e-3, 4
@@ -75,7 +76,7 @@ bed_stress = "{bed_stress}"
 
 def run_bed(speed: float, bed_stress: str, end: float) -> ProppantSimulation:
     """The slot with its packed bed (16 parcels a cell, uniform at random) and the fluid at rest, run to ``end``."""
-    sim = ProppantSimulation(load_scene(scene(speed, bed_stress, end)))
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(scene(speed, bed_stress, end))))
     rng = np.random.default_rng(0)
     n = int(L / DZ) * ROWS * 16
     per = THETA * L * ROWS * DZ * W / (4 / 3 * np.pi * RADIUS ** 3) / n

@@ -15,6 +15,7 @@ import pytest
 
 from hfgpu import load_scene
 from hfgpu.proppant.analysis import bank
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
 SCENE = (files("hfgpu") / "scenes" / "chun2020_slot.toml").read_text()
@@ -30,7 +31,7 @@ def test_slot_scene_matches_the_experiment():
     c = 1.5 * 0.45359237 / 3.785411784e-3
     assert scene.injection.schedule.proppant_fraction(1.0)[1] == pytest.approx((c / 2550) / (1 + c / 2550), rel=1e-5)
     assert scene.proppant.classes[0].size.d_min == pytest.approx(0.3e-3)  # 30/50 mesh
-    sim = ProppantSimulation(scene)
+    sim = ProppantSimulation(proppant_engine_setup(scene))
     sources = sim.injector.fluid_sources(0.0, 0.1)
     assert sources.sum() == pytest.approx((1 - 0.065845) * q, rel=1e-5)
     assert np.all(np.nonzero(sources)[1] == 0) and len(sim.injector.inlets) == 3  # three inlets, left end
@@ -60,7 +61,7 @@ def test_chun_bank_length_and_area(shared_dir):
         def proppant_balance(self, record):
             pass
 
-    sim = ProppantSimulation(load_scene(SCENE))
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(SCENE)))
     sink = Sink()
     sim.run(sink)
     by_time = {round(s.time, 6): s for s in sink.snapshots}

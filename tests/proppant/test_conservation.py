@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from hfgpu import load_scene
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
 SLOT = """
@@ -67,7 +68,7 @@ class Recorder:
 
 def test_solid_and_fluid_balance_every_step():
     scene = load_scene(SLOT)
-    sim = ProppantSimulation(scene)
+    sim = ProppantSimulation(proppant_engine_setup(scene))
     sink = Recorder()
     residuals = []
     summary = sim.run(sink, on_step=lambda info: residuals.append(info.continuity_residual))
@@ -91,7 +92,7 @@ def test_solid_and_fluid_balance_every_step():
 def test_non_finite_state_raises_with_time_and_cell():
     from hfgpu.errors import SimulationError
 
-    sim = ProppantSimulation(load_scene(SLOT))
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(SLOT)))
     sim.step()
     parcels = sim.parcels
     parcels.x[0] = np.nan
@@ -127,7 +128,7 @@ def test_time_varying_width_and_leakoff_keep_the_solid_balance():
         width[:, 10:] *= 1.0 + 2.0 * t
         return width, np.full((10, 20), 1e-6)
 
-    sim = ProppantSimulation(scene, width_field=width_field)
+    sim = ProppantSimulation(proppant_engine_setup(scene), width_field=width_field)
     sink = Recorder()
     residuals = []
     sim.run(sink, on_step=lambda info: residuals.append(info.continuity_residual))

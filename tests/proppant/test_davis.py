@@ -18,6 +18,7 @@ import pytest
 
 from hfgpu import load_scene
 from hfgpu.proppant.analysis import class_volume_fraction, fitted_speed, interface_depth, row_profile
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 from hfgpu.reference.settling import bidisperse_batch
 
@@ -44,7 +45,7 @@ def interfaces(sim: ProppantSimulation, phi_light_only: float) -> tuple[float, f
 def measured_speeds(text: str, end: float, window_depths: tuple[float, float]) -> tuple[float, float, float]:
     scene = load_scene(text)
     theory = kynch(scene)
-    sim = ProppantSimulation(scene)
+    sim = ProppantSimulation(proppant_engine_setup(scene))
     record = []
     while sim.time < end - 1e-9:
         sim.step(limit=end - sim.time)

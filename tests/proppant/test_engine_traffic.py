@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from hfgpu import load_scene
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
 from .test_conservation import SLOT
@@ -17,7 +18,7 @@ def traffic(per_cell: int) -> tuple[list[int], list[int], list[int], int, int]:
     per cell, the parcels at the end and the grid's node count."""
     scene = load_scene(SLOT.replace('backend = "numpy"', 'backend = "taichi"').replace(
         "parcels_per_cell = 4", f"parcels_per_cell = {per_cell}"))
-    sim = ProppantSimulation(scene)
+    sim = ProppantSimulation(proppant_engine_setup(scene))
     engine = sim.engine
     launches, arrays, volume = [], [], []
     for _ in range(4):

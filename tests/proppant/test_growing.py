@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from hfgpu import load_scene
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
 BOX = """
@@ -55,7 +56,7 @@ def radial_width(t: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def test_radially_growing_width_field_runs_stably_and_conserves_fluid_and_solids():
-    sim = ProppantSimulation(load_scene(BOX), width_field=radial_width)
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(BOX)), width_field=radial_width)
     start = int(np.count_nonzero(sim.grid.active))
     dts = []
     while sim.time < 2.0 - 1e-9:

@@ -129,10 +129,11 @@ def test_a_zero_length_step_is_a_clear_error():
     from pathlib import Path
 
     from hfgpu import SimulationError, load_scene
+    from hfgpu.proppant.engine_setup import proppant_engine_setup
     from hfgpu.proppant.simulator import ProppantSimulation
 
     scene = load_scene(Path(__file__).resolve().parents[2] / "hfgpu" / "scenes" / "settling_stokes.toml")
-    sim = ProppantSimulation(scene)
+    sim = ProppantSimulation(proppant_engine_setup(scene))
     with pytest.raises(SimulationError, match="zero-length time step"):
         sim.step(limit=0.0)
 

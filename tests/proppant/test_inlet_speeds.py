@@ -32,6 +32,7 @@ import pytest
 from hfgpu import load_scene
 from hfgpu.proppant.config import Geometry, Port
 from hfgpu.proppant.grid import face_mean
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
 RATE = 3e-4  # slurry rate Q [m^3/s]
@@ -113,8 +114,8 @@ def parcel_speed_bound(sim: ProppantSimulation) -> float:
 
 
 def test_packed_inlet_drives_no_eddies():
-    sim = ProppantSimulation(packed_inlet_scene())
-    end = sim.scene.run.end_time
+    sim = ProppantSimulation(proppant_engine_setup(packed_inlet_scene()))
+    end = sim.setup.end_time
     worst_flux = worst_parcel = 0.0
     while sim.time < end - 1e-12:
         sim.step(limit=end - sim.time)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from hfgpu import load_scene
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
 LENGTH, HEIGHT, THETA = 1.0, 0.2, 0.05
@@ -69,7 +70,7 @@ def heavy_front(sim: ProppantSimulation) -> float:
 
 def test_lock_exchange_front_runs_at_the_inertial_speed():
     scene = load_scene(SCENE)
-    sim = ProppantSimulation(scene)
+    sim = ProppantSimulation(proppant_engine_setup(scene))
     parcels = sim.parcels
     parcels.drop(parcels.x > 0.5 * LENGTH)  # the lock: suspension in the left half only
     sim.set_parcels(parcels)

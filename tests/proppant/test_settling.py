@@ -17,6 +17,7 @@ import pytest
 from hfgpu import load_scene
 from hfgpu.proppant.analysis import fitted_speed, interface_depth, row_profile
 from hfgpu.proppant.injection import make_batch
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 from hfgpu.reference import settling
 
@@ -33,7 +34,7 @@ def drag_law(params):
 
 def single_particle_velocity(text: str, duration: float) -> tuple[float, ProppantSimulation]:
     """Settling speed of one parcel of one particle released at rest near the top of the box."""
-    sim = ProppantSimulation(load_scene(text))
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(text)))
     cls = sim.setup.classes[0]
     sim.add_parcels(make_batch([0.5 * sim.setup.geometry.length + 1e-4], [0.01], [cls.size.mean],
                                cls.density, 1.0, 0))
@@ -67,7 +68,7 @@ def test_single_particle_drag_law():
 def top_interface_speed(text: str, t_fit: tuple[float, float]) -> tuple[float, float]:
     """(measured top-interface speed, bulk parcel speed) of an initially uniform column; the interface is where
     theta_p crosses half its initial value, fitted over t_fit."""
-    sim = ProppantSimulation(load_scene(text))
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(text)))
     phi0 = sim.setup.classes[0].initial_volume_fraction
     times, depths = [], []
     while sim.time < t_fit[1] - 1e-9:

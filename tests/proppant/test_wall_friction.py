@@ -17,6 +17,7 @@ from hfgpu.kernels.closures.wall_friction import wall_friction_code, wall_fricti
 from hfgpu.proppant.fluid import FluidNumerics, FluidSolver
 from hfgpu.proppant.grid import StaggeredGrid
 from hfgpu.proppant.params import MppicParams
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
 RHO, MU, GAP, HEIGHT = 1000.0, 1e-3, 5e-3, 0.1
@@ -68,7 +69,7 @@ def test_wall_friction_knob():
     assert MppicParams().wall_friction == "laminar"
     text = (files("hfgpu") / "scenes" / "chun2020_slot.toml").read_text()
     assert load_scene(text).proppant.params.wall_friction == "dean"
-    sim = ProppantSimulation(load_scene(text.replace("[mppic]", '[mppic]\nbackend = "numpy"')))
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(text.replace("[mppic]", '[mppic]\nbackend = "numpy"'))))
     assert sim.solver.wall_friction == "dean"  # what the momentum predictor is given
     assert load_scene(text.replace('wall_friction = "dean"', "")).proppant.params.wall_friction == "laminar"
     with pytest.raises(SceneError, match="wall_friction"):
