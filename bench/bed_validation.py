@@ -173,6 +173,13 @@ def measure(shields: float, start: float = 0.5, end: float = 1.5, extra: str = "
               f"{TOP - 2}..{round(H / DZ) - 1}: " + " ".join(f"{v:.3g}" for v in r["rows"])
               + f"; bed rows at {end:g} s: max |u| {r['bed_u_max']:.3g} m/s, max speed {r['bed_speed_max']:.3g} m/s",
               flush=True)
+        theta_p = sim.moments.volume_fraction
+        for row in range(TOP - 2, round(H / DZ)):
+            own = k == row
+            print(f"    at {end:g} s, row {row}{' (bed top)' if row == TOP else ''}: fluid u over the middle half "
+                  f"mean {np.mean(sim.fluid.u[row, mid]):.3g} m/s, max |u| {np.abs(sim.fluid.u[row, mid]).max():.3g}; "
+                  f"theta_p {np.mean(theta_p[row, nx // 4:3 * nx // 4]):.3f}; {own.sum()} parcels, fastest "
+                  f"{np.abs(p.u[own]).max() if own.any() else 0.0:.3g} m/s along x", flush=True)
     return r
 
 

@@ -36,9 +36,9 @@ MEASURED = {0.07: (0.0797, 0.0, 0.0, 0.0473), 0.10: (0.1037, 0.0148, 0.0148, 0.1
 
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason="q* / MPM measured 0 / 0.14 / 19 / 36 (bed rows; total load 0 / 0.14 / "
-                   "66 / 49) at Shields numbers 0.080 / 0.104 / 0.100 / 0.148: no grain moves at 1.6 theta_cr (only a "
-                   "grain in a loose cell on a dense one feels the threshold of motion; the bed's top cell is dense), "
-                   "and once the bed's grains are carried up into the flow the whole bed slides "
+                   "66 / 48) at Shields numbers 0.080 / 0.104 / 0.100 / 0.148: no grain moves at 1.6 theta_cr (a surface "
+                   "grain's threshold of motion sees the fluid inside the bed's top cell, at most 2.7 mm/s under a "
+                   "0.28 m/s flow), and once the bed's grains are carried up into the flow the whole bed slides "
                    "(docs/validation.md, Bed load)")
 @pytest.mark.parametrize("shields", [0.07, 0.10, 0.15, 0.20])
 def test_bed_load_within_a_factor_of_two_of_meyer_peter_mueller(shields):
