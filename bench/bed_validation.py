@@ -5,6 +5,7 @@ docs/validation.md reports them.
 
     python bench/bed_validation.py load [--shields 0.07 0.10 0.15 0.20] [--set bed_stress=overburden]
     python bench/bed_validation.py repose [--end 8] [--set KEY=VALUE]
+    python bench/bed_validation.py collapse [--end 3] [--set KEY=VALUE]   # a packed column released
 
 Every run is one process, NumPy backend, one core.
 
@@ -281,9 +282,64 @@ def pour(end: float = 8.0, extra: str = "", quiet: bool = False) -> dict:
     return r
 
 
+def column_scene_text(end: float, extra: str = "") -> str:
+    return f"""
+[run]
+end_time = "{end} s"
+physics = ["proppant"]
+seed = 1
+[fluid]
+viscosity = "1 cP"
+[mesh]
+cell_size = "{DZ} m"
+[output]
+every = "1 s"
+[geometry]
+kind = "box"
+length = "{PILE_L} m"
+height = "{PILE_H} m"
+width = "{W} m"
+[[proppant]]
+name = "sand"
+density = "2650 kg/m**3"
+diameter = "0.3 mm"
+[mppic]
+backend = "numpy"
+{extra}
+"""
+
+
+def collapse(end: float = 3.0, columns: int = 4, rows: int = 12, extra: str = "", quiet: bool = False) -> dict:
+    """Release a packed column of sand (theta_p 0.58, ``columns`` cells wide, ``rows`` cells high, a 4 x 4
+    lattice of parcels a cell) standing on the floor in the middle of the closed slot of ``pour``, in water at
+    rest, and measure its surface and flank angles at ``end`` as ``pour`` does."""
+    sim = ProppantSimulation(load_scene(column_scene_text(end, extra)))
+    q = 4
+    nx = round(PILE_L / DZ)
+    left = (nx - columns) // 2 * DZ
+    x, z = np.meshgrid(left + (np.arange(columns * q) + 0.5) * DZ / q, PILE_H - (np.arange(rows * q) + 0.5) * DZ / q)
+    per = THETA * DZ * DZ * W / (np.pi / 6 * D ** 3) / q ** 2
+    sim.set_parcels(Parcels.create(x.ravel(), z.ravel(), radius=D / 2, density=RHO_P, particles=per))
+    sim.fluid = sim.solver.initial_state(sim._fluid_theta_p())
+    before = surface(sim.moments.volume_fraction, 0.5 * sim.params.theta_cp)
+    while sim.time < end - 1e-9:
+        sim.step(limit=end - sim.time)
+    heights = surface(sim.moments.volume_fraction, 0.5 * sim.params.theta_cp)
+    top, left_angle, right_angle = flank_angles(heights)
+    p = sim.parcels
+    r = {"end": end, "peak": top, "left": left_angle, "right": right_angle, "angle": 0.5 * (left_angle + right_angle),
+         "heights": heights, "before": before, "speed_max": float(np.hypot(p.u, p.v).max())}
+    if not quiet:
+        print("column at 0 s: surface heights [mm] " + " ".join(f"{1e3 * h:.1f}" for h in before))
+        print(f"column at {end:g} s: surface heights [mm] " + " ".join(f"{1e3 * h:.1f}" for h in heights))
+        print(f"peak {1e3 * top:.1f} mm, flank angles {left_angle:.1f} / {right_angle:.1f} deg; fastest grain "
+              f"{r['speed_max']:.3g} m/s", flush=True)
+    return r
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("case", choices=("load", "repose"))
+    parser.add_argument("case", choices=("load", "repose", "collapse"))
     parser.add_argument("--shields", type=float, nargs="+", default=[0.07, 0.10, 0.15, 0.20])
     parser.add_argument("--start", type=float, default=0.5)
     parser.add_argument("--end", type=float, default=None)
@@ -294,8 +350,10 @@ def main() -> None:
     if args.case == "load":
         for s in args.shields:
             measure(s, args.start, args.end or 1.5, extra)
-    else:
+    elif args.case == "repose":
         pour(args.end or 8.0, extra)
+    else:
+        collapse(args.end or 3.0, extra=extra)
     print(f"wall {time.perf_counter() - t0:.0f} s")
 
 
