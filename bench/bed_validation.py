@@ -3,7 +3,7 @@ against Meyer-Peter & Mueller (1948), and the angle of repose of a pile poured i
 measurements are here; tests/proppant/test_bed_load.py and tests/proppant/test_repose.py assert them and
 docs/validation.md reports them.
 
-    python bench/bed_validation.py load [--shields 0.07 0.10 0.15 0.20] [--set bed_stress=overburden]
+    python bench/bed_validation.py load [--shields 0.07 0.10 0.15 0.20] [--set 'bed_stress="overburden"']
     python bench/bed_validation.py repose [--end 8] [--set KEY=VALUE]
     python bench/bed_validation.py collapse [--end 3] [--set KEY=VALUE]   # a packed column released
 
@@ -31,8 +31,8 @@ of the slot (x in [L/4, 3L/4]), sampled every 50 ms over the window:
 
 The 2 cP viscosity puts the model's critical Shields number (Soulsby & Whitehouse 1997, D* = 4.8: theta_cr
 0.0495) at Meyer-Peter & Mueller's 0.047 and keeps the gap Reynolds number rho U_f w / mu of the runs at
-700-1700 (laminar wall friction, the default). MPM was fitted to turbulent flume data of coarse grains
-(0.4-29 mm): this is a comparison with a law at the edge of its range, as the issue asks for.
+700-1600 (laminar wall friction, the default). MPM was fitted to turbulent flume data of coarse grains
+(0.4-29 mm): this compares the model with a law at the edge of that law's range.
 
 Angle of repose (``pour``): a slot 16 cm long, 8 cm high, gap 5 mm, 5 mm cells, water (1 cP); slurry of 0.3 mm
 sand (2650 kg/m^3) at volume fraction 0.2 enters through one cell at the top, in the middle (a source, no jet),
