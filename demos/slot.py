@@ -89,6 +89,15 @@ def main() -> None:
     fig.savefig(out / "slot_bank.png", dpi=150)
     for s, b in zip(sink.proppant_snapshots, banks):
         print(f"t = {s.time:5.1f} s  bank length {b.normalised_length:.3f}  area {b.normalised_area:.3f}")
+    if Path(args.data).is_file():
+        by_time = {round(s.time, 6): b for s, b in zip(sink.proppant_snapshots, banks)}
+        print("against the experiment (Chun et al. 2020, digitised by GEOS): model / measured - 1")
+        for t_data, length, area in np.loadtxt(args.data):
+            b = by_time.get(round(t_data, 6))
+            if b is not None:
+                print(f"t = {t_data:5.1f} s  length {b.normalised_length:.3f} vs {length:.3f} "
+                      f"({100 * (b.normalised_length / length - 1):+.1f} %)  area {b.normalised_area:.3f} vs "
+                      f"{area:.3f} ({100 * (b.normalised_area / area - 1):+.1f} %)")
     fractions = (0.3, 0.4, 0.5, 0.6, 0.7)
     print("bank length against the bank threshold (theta_p >= fraction x theta_cp; the validation uses 0.5):")
     print("    t [s] | " + " | ".join(f"{f:5.1f}" for f in fractions))
