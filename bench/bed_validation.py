@@ -52,6 +52,7 @@ import numpy as np
 from hfgpu import load_scene
 from hfgpu.kernels.closures import bed
 from hfgpu.proppant.parcels import Parcels
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
 # bed load
@@ -130,7 +131,7 @@ def measure(shields: float, start: float = 0.5, end: float = 1.5, extra: str = "
             quiet: bool = False) -> dict:
     """Run the bed under the flow aimed at ``shields`` and average the figures of the module docstring over
     the samples in [start, end]; also the fastest grain along x and overall of the bed's rows at ``end``."""
-    sim = ProppantSimulation(load_scene(load_scene_text(speed_for(shields), end, extra)))
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(load_scene_text(speed_for(shields), end, extra))))
     nx = round(L / DZ)
     q = 4
     x, z = np.meshgrid((np.arange(nx * q) + 0.5) * DZ / q, H - (np.arange(ROWS * q) + 0.5) * DZ / q)
@@ -264,7 +265,7 @@ def flank_angles(heights: np.ndarray, dx: float = DZ) -> tuple[float, float, flo
 
 def pour(end: float = 8.0, extra: str = "", quiet: bool = False) -> dict:
     """Pour the pile for ``end`` seconds; its surface, flank angles and the fastest grain in it at the end."""
-    sim = ProppantSimulation(load_scene(pile_scene_text(end, extra=extra)))
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(pile_scene_text(end, extra=extra))))
     while sim.time < end - 1e-9:
         sim.step(limit=end - sim.time)
     theta = sim.moments.volume_fraction
@@ -313,7 +314,7 @@ def collapse(end: float = 3.0, columns: int = 4, rows: int = 12, extra: str = ""
     """Release a packed column of sand (theta_p 0.58, ``columns`` cells wide, ``rows`` cells high, a 4 x 4
     lattice of parcels a cell) standing on the floor in the middle of the closed slot of ``pour``, in water at
     rest, and measure its surface and flank angles at ``end`` as ``pour`` does."""
-    sim = ProppantSimulation(load_scene(column_scene_text(end, extra)))
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(column_scene_text(end, extra))))
     q = 4
     nx = round(PILE_L / DZ)
     left = (nx - columns) // 2 * DZ
