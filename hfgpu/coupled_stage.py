@@ -37,8 +37,8 @@ from .fracture.engine_setup import fracture_engine_setup
 from .fracture.mesh import injection_cell_centre
 from .io.sink import ResultsSink
 from .propped import created_area, propped_cells
-from .proppant.config import Port
 from .proppant.engine_setup import proppant_engine_setup
+from .proppant.injection import batch_solid_volume
 from .proppant.simulator import ProppantSimulation
 from .records import GridFrame, ProppantSnapshot, StageRecord, StageSnapshot
 from .scene import Scene
@@ -161,7 +161,7 @@ def cluster_values(snap: ProppantSnapshot, clusters: int, theta_cp: float) -> di
     """Per cluster of a stage's proppant snapshot: ``cluster_<i>_solid`` [m^3], ``cluster_<i>_solid_share``,
     ``cluster_<i>_propped_area`` and ``cluster_<i>_created_area`` [m^2] (module docstring)."""
     views = [cluster_view(snap, i) for i in range(clusters)]
-    solids = [float(np.sum(v.parcels["particles"] * 4.0 / 3.0 * math.pi * v.parcels["radius"] ** 3)) for v in views]
+    solids = [batch_solid_volume(v.parcels) for v in views]
     total = sum(solids)
     area = snap.frame.dx * snap.frame.dz
     out: dict[str, float] = {}

@@ -84,12 +84,11 @@ class ClusterSplit:
         return taken / total if total > 0.0 else np.full(n, 1.0 / n)
 
 
-def _columns(snap: ProppantSnapshot, cluster: int) -> tuple[int, int]:
-    """(first, stop) columns of a cluster's block in a stage's proppant snapshot."""
-    labels = snap.grid.get("cluster")
-    if labels is None:
-        raise ValueError("cluster_view: the snapshot has no grid field 'cluster' (not a stage's proppant)")
-    columns = np.flatnonzero(np.any(np.asarray(labels) == cluster, axis=0))
+def block_columns(labels: np.ndarray, cluster: int) -> tuple[int, int]:
+    """(first, stop) columns of a cluster's block, from the grid field ``cluster`` (``labels``) of a stage's
+    proppant grid (its snapshots, or a map on the same grid such as the closure map)."""
+    labels = np.asarray(labels)
+    columns = np.flatnonzero(np.any(labels == cluster, axis=0))
     if not columns.size:
         raise ValueError(f"cluster_view: no cluster {cluster} in the snapshot (clusters 0-{int(labels.max())})")
     return int(columns[0]), int(columns[-1]) + 1
@@ -105,7 +104,9 @@ def cluster_view(snap: ProppantSnapshot, cluster: int) -> ProppantSnapshot:
     """Cluster ``cluster``'s part of a stage's proppant snapshot: its block's cell fields (nz, nx), x-face fields
     (nz, nx + 1) and z-face fields (nz + 1, nx), and the parcels in it with x moved back by the block's shift, on
     the plane's frame."""
-    first, stop = _columns(snap, cluster)
+    if "cluster" not in snap.grid:
+        raise ValueError("cluster_view: the snapshot has no grid field 'cluster' (not a stage's proppant)")
+    first, stop = block_columns(snap.grid["cluster"], cluster)
     nz, n_total = np.asarray(snap.grid["cluster"]).shape
     grid = {}
     for name, values in snap.grid.items():

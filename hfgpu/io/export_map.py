@@ -21,6 +21,7 @@ import numpy as np
 from ..closure.conductivity import ClosureMap, closure_of
 from ..errors import HfgpuError
 from ..records import GridFrame
+from ..stage_blocks import block_columns
 
 #: The fracture's fields on the export map (created width [m], fluid pressure [Pa]).
 FRACTURE_FIELDS = ("width", "pressure")
@@ -44,8 +45,7 @@ class ExportMap:
 def cluster_closure(closure: ClosureMap, labels: np.ndarray, cluster: int) -> ClosureMap:
     """Cluster ``cluster``'s columns of a stage's closure map (its clusters side by side; ``labels``: the grid
     field ``cluster`` of the proppant snapshot it was computed from, hfgpu.stage_blocks)."""
-    columns = np.flatnonzero(np.any(np.asarray(labels) == cluster, axis=0))
-    cut = slice(int(columns[0]), int(columns[-1]) + 1)
+    cut = slice(*block_columns(labels, cluster))
     return dataclasses.replace(closure, fields={name: values[:, cut] for name, values in closure.fields.items()},
                                clusters=())
 

@@ -30,6 +30,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ..errors import HfgpuError
+from ..proppant.injection import batch_solid_volume
 from ..records import GridFrame, ProppantSnapshot
 from ..stage_blocks import cluster_view, clusters_of
 from .display_units import SI, FigureUnits
@@ -380,8 +381,7 @@ def stage_proppant(results: Results, boundaries: Sequence[float] = (), units: Fi
         _layers_on_map(ax, view.frame, view.grid["volume_fraction"].shape, boundaries, units=u)
     sand, fluid = bottom.subplots(1, 2)
     times = np.array([snap.time for snap in snaps])
-    solids = np.array([[float(np.sum(v.parcels["particles"] * 4.0 / 3.0 * np.pi * v.parcels["radius"] ** 3))
-                        for v in (cluster_view(snap, i) for i in range(n))] for snap in snaps])
+    solids = np.array([[batch_solid_volume(cluster_view(snap, i).parcels) for i in range(n)] for snap in snaps])
     labels = [f"cluster {i + 1}" for i in range(n)]
     sand.stackplot(times, *u("solid_volume", solids).T, labels=labels)
     sand.set(xlabel="time [s]", ylabel=f"proppant in the cluster [{u.label('solid_volume')}]",
