@@ -84,25 +84,30 @@ def mppic_lines(settings) -> str:
     return "\n".join(f"{k.strip()} = {v.strip()}" for k, v in (s.split("=", 1) for s in settings))
 
 
-def load_scene_text(speed: float, end: float, extra: str = "") -> str:
-    clear = H - ROWS * DZ
+def scene_head(end: float, fluid: str, kind: str, length: float, height: float) -> str:
+    """The scene text the three set-ups share: proppant only to ``end`` [s], seed 1, ``fluid`` ([fluid] lines),
+    cells of DZ, a ``kind`` ("slot" or "box") of ``length`` x ``height`` [m] and gap W."""
     return f"""
 [run]
 end_time = "{end} s"
 physics = ["proppant"]
 seed = 1
 [fluid]
-viscosity = "{MU * 1e3:g} cP"
-density = "{RHO_F:g} kg/m**3"
+{fluid}
 [mesh]
 cell_size = "{DZ} m"
 [output]
 every = "1 s"
 [geometry]
-kind = "slot"
-length = "{L} m"
-height = "{H} m"
-width = "{W} m"
+kind = "{kind}"
+length = "{length} m"
+height = "{height} m"
+""" + f'width = "{W} m"'
+
+
+def load_scene_text(speed: float, end: float, extra: str = "") -> str:
+    clear = H - ROWS * DZ
+    return scene_head(end, f'viscosity = "{MU * 1e3:g} cP"\ndensity = "{RHO_F:g} kg/m**3"', "slot", L, H) + f"""
 [[geometry.inlets]]
 kind = "segment"
 x = "1 mm"
@@ -186,22 +191,7 @@ def measure(shields: float, start: float = 0.5, end: float = 1.5, extra: str = "
 
 
 def pile_scene_text(end: float, solid_rate: float = 5e-7, extra: str = "") -> str:
-    return f"""
-[run]
-end_time = "{end} s"
-physics = ["proppant"]
-seed = 1
-[fluid]
-viscosity = "1 cP"
-[mesh]
-cell_size = "{DZ} m"
-[output]
-every = "1 s"
-[geometry]
-kind = "slot"
-length = "{PILE_L} m"
-height = "{PILE_H} m"
-width = "{W} m"
+    return scene_head(end, 'viscosity = "1 cP"', "slot", PILE_L, PILE_H) + f"""
 [[geometry.inlets]]
 kind = "point"
 x = "{PILE_L / 2 + DZ / 2} m"
@@ -284,22 +274,7 @@ def pour(end: float = 8.0, extra: str = "", quiet: bool = False) -> dict:
 
 
 def column_scene_text(end: float, extra: str = "") -> str:
-    return f"""
-[run]
-end_time = "{end} s"
-physics = ["proppant"]
-seed = 1
-[fluid]
-viscosity = "1 cP"
-[mesh]
-cell_size = "{DZ} m"
-[output]
-every = "1 s"
-[geometry]
-kind = "box"
-length = "{PILE_L} m"
-height = "{PILE_H} m"
-width = "{W} m"
+    return scene_head(end, 'viscosity = "1 cP"', "box", PILE_L, PILE_H) + f"""
 [[proppant]]
 name = "sand"
 density = "2650 kg/m**3"
