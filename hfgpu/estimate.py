@@ -118,7 +118,7 @@ def estimate(scene: Any) -> Estimate | None:
 
     end = radial(t_pump)
     radius = float(end.R[-1])
-    if not (math.isfinite(radius) and math.isfinite(float(end.efficiency[-1]))):
+    if not all(math.isfinite(float(v[-1])) for v in (end.R, end.w0, end.efficiency)):
         return None   # the closed form overflows (an absurd modulus or rate): nothing to expect
     first: dict[str, tuple[float, float]] = {}
     for name, t in first_pumped(scene.injection.schedule).items():

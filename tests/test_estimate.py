@@ -4,6 +4,8 @@ treatments an engineer gets wrong (a grain too large for the opening, a rate too
 
 from __future__ import annotations
 
+import dataclasses
+
 import subprocess
 import sys
 from pathlib import Path
@@ -144,3 +146,12 @@ def test_an_overflowing_closed_form_expects_nothing():
     instead of failing."""
     text = (Path(__file__).resolve().parents[1] / "hfgpu" / "scenes" / "radial_I.toml").read_text()
     assert estimate(load_scene(text.replace('youngs_modulus = "40 GPa"', "youngs_modulus = 1e300"))) is None
+
+
+def test_an_underflowing_time_scale_expects_nothing():
+    """E = K_Ic = 6.7e128 (tests/test_cli_fuzz.py found it): the M-K time t_mk underflows to 0 and E' t_mk with it,
+    so the opening scale mu' / (E' t_mk) divided by zero; check expects nothing instead of failing."""
+    text = (Path(__file__).resolve().parents[1] / "hfgpu" / "scenes" / "radial_I.toml").read_text()
+    scene = load_scene(text.replace('youngs_modulus = "40 GPa"', "youngs_modulus = 6.7392039258320385e+128"))
+    scene = scene.replace(rock=dataclasses.replace(scene.rock, toughness=6.7392039258320385e+128))
+    assert estimate(scene) is None

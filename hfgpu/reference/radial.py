@@ -365,9 +365,9 @@ def dontsov_radial(E_prime, K_prime, mu_prime, C_prime, Q0, t) -> RadialSolution
     if tt.ndim != 1 or tt.size < 10 or np.any(np.diff(tt) <= 0.0):
         raise ValueError(f"t: got an array of shape {tt.shape}; must be a scalar or a strictly increasing "
                          "1-D array of at least 10 times")
-    tmk = float(t_mk(E_prime, K_prime, mu_prime, Q0))
+    tmk = np.float64(t_mk(E_prime, K_prime, mu_prime, Q0))
     ph = max(float(phi(E_prime, K_prime, mu_prime, C_prime, Q0)), 1e-30)
-    E, mu, Q = float(E_prime), float(mu_prime), float(Q0)
+    E, mu, Q = np.float64(E_prime), np.float64(mu_prime), np.float64(Q0)
     th = 2.0**6 * ph**1.5 * tt / tmk
     Qh = 8.0 * ph / np.pi
 
@@ -394,8 +394,9 @@ def dontsov_radial(E_prime, K_prime, mu_prime, C_prime, Q0, t) -> RadialSolution
 
     lam, eta, _, dlt = _lambda_and_efficiency(Kh, Ch, alpha)
     s = g_delta(Kh, Ch)
-    L_star = (Q**3 * E * tmk**4 / mu) ** (1.0 / 9.0)
-    eps_star = (mu / (E * tmk)) ** (1.0 / 3.0)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):   # absurd inputs: inf or NaN, not an error
+        L_star = (Q**3 * E * tmk**4 / mu) ** (1.0 / 9.0)
+        eps_star = (mu / (E * tmk)) ** (1.0 / 3.0)
     R = Ch**4 * s**2 / Kh**10 / (16.0 * ph) * L_star
     w0 = Ch**2 * s / (Kh**6 * 2.0**lam) / (4.0 * np.sqrt(ph)) * eps_star * L_star
     sol = RadialSolution(t=tt, R=R, w0=w0, efficiency=eta, delta=dlt, lam=lam)
