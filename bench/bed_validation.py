@@ -4,7 +4,7 @@ measurements are here; tests/proppant/test_bed_load.py and tests/proppant/test_r
 docs/validation.md reports them.
 
     python bench/bed_validation.py load [--shields 0.07 0.10 0.15 0.20] [--set 'bed_stress="overburden"']
-    python bench/bed_validation.py repose [--end 8] [--set KEY=VALUE]
+    python bench/bed_validation.py repose [--end 8] [--rest 4] [--set bed_slope=true]   # poured, then at rest
     python bench/bed_validation.py collapse [--end 3] [--set KEY=VALUE]   # a packed column released
 
 Every run is one process, NumPy backend, one core.
@@ -190,8 +190,9 @@ def measure(shields: float, start: float = 0.5, end: float = 1.5, extra: str = "
     return r
 
 
-def pile_scene_text(end: float, solid_rate: float = 5e-7, extra: str = "") -> str:
-    return scene_head(end, 'viscosity = "1 cP"', "slot", PILE_L, PILE_H) + f"""
+def pile_scene_text(end: float, rest: float = 0.0, solid_rate: float = 5e-7, extra: str = "") -> str:
+    rest_line = f', {{ until = "{end + rest} s", rate = "0 m**3/s" }}' if rest > 0.0 else ""
+    return scene_head(end + rest, 'viscosity = "1 cP"', "slot", PILE_L, PILE_H) + f"""
 [[geometry.inlets]]
 kind = "point"
 x = "{PILE_L / 2 + DZ / 2} m"
@@ -205,7 +206,7 @@ kind = "point"
 x = "{PILE_L - DZ / 2} m"
 depth = "{DZ / 2} m"
 [injection]
-schedule = [{{ until = "{end} s", rate = "{solid_rate / 0.2} m**3/s", proppant = "sand", volume_fraction = 0.2 }}]
+schedule = [{{ until = "{end} s", rate = "{solid_rate / 0.2} m**3/s", proppant = "sand", volume_fraction = 0.2 }}{rest_line}]
 [[proppant]]
 name = "sand"
 density = "2650 kg/m**3"
@@ -253,9 +254,11 @@ def flank_angles(heights: np.ndarray, dx: float = DZ) -> tuple[float, float, flo
     return top, angles[0], angles[1]
 
 
-def pour(end: float = 8.0, extra: str = "", quiet: bool = False) -> dict:
-    """Pour the pile for ``end`` seconds; its surface, flank angles and the fastest grain in it at the end."""
-    sim = ProppantSimulation(proppant_engine_setup(load_scene(pile_scene_text(end, extra=extra))))
+def pour(end: float = 8.0, extra: str = "", quiet: bool = False, rest: float = 0.0) -> dict:
+    """Pour the pile for ``end`` seconds and let it rest ``rest`` seconds more (no flow); its surface, flank
+    angles and the fastest grain in it at the end."""
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(pile_scene_text(end, rest, extra=extra))))
+    end = end + rest
     while sim.time < end - 1e-9:
         sim.step(limit=end - sim.time)
     theta = sim.moments.volume_fraction
@@ -319,6 +322,7 @@ def main() -> None:
     parser.add_argument("--shields", type=float, nargs="+", default=[0.07, 0.10, 0.15, 0.20])
     parser.add_argument("--start", type=float, default=0.5)
     parser.add_argument("--end", type=float, default=None)
+    parser.add_argument("--rest", type=float, default=0.0, help="repose: seconds at rest after the pour")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="an [mppic] key")
     args = parser.parse_args()
     extra = mppic_lines(args.set)
@@ -327,7 +331,7 @@ def main() -> None:
         for s in args.shields:
             measure(s, args.start, args.end or 1.5, extra)
     elif args.case == "repose":
-        pour(args.end or 8.0, extra)
+        pour(args.end or 8.0, extra, rest=args.rest)
     else:
         collapse(args.end or 3.0, extra=extra)
     print(f"wall {time.perf_counter() - t0:.0f} s")

@@ -75,9 +75,9 @@ def substep(P: F2, S: I2, W: F2, C: F3, XF: F3, ZF: F3, FLAGS: I2, CD: F4, XD: F
             ST: F1, n: ti.i32, blocks: ti.i32, copies: ti.i32, private: ti.template(), h: ti.f64, step: ti.i32,
             substeps: ti.f64):
     """One particle sub-step of length h (the ``step``-th of ``substeps``): scatter (Eq. 38) -> cell fields
-    (theta_p, tau, damping, flags) -> the overburden's bed friction (one thread per column) -> stress gradients
-    -> gather (Eq. 40-41) -> push (Eq. 43-44) -> exchange (Eq. 39) with the outlets and the finiteness check ->
-    face means of F and beta over the sub-loop."""
+    (theta_p, tau, damping, flags) -> the bed's overburden friction and slope loads (one thread per column) ->
+    stress gradients -> gather (Eq. 40-41) -> push (Eq. 43-44) -> exchange (Eq. 39) with the outlets and the
+    finiteness check -> face means of F and beta over the sub-loop."""
     if step == 0:
         ST[ST_OUTFLOW] = 0.0
         ST[ST_LEFT] = 0.0
@@ -89,7 +89,7 @@ def substep(P: F2, S: I2, W: F2, C: F3, XF: F3, ZF: F3, FLAGS: I2, CD: F4, XD: F
     particles.scatter_pass(P, S, n, C, FLAGS, CD, BS, blocks, private, PR, ST)
     grid.finish_cells(C, CD, copies, PR)
     grid.flags_pass(C, FLAGS, PR)
-    grid.bed_strength_pass(C, PR)
+    grid.bed_pass(C, PR)
     grid.stress_gradient(C, XF, PR[P_DX], 1)
     grid.stress_gradient(C, ZF, PR[P_DZ], 0)
     particles.gather_pass(P, S, W, n, C, XF, ZF, FLAGS, PR, step == 0)

@@ -9,7 +9,7 @@ from hfgpu.kernels.closures import bed, damping, particle_stress
 from hfgpu.kernels.layout import (
     BED_STRENGTH, CELL, DAMPING, DEPOSIT_BETA, DEPOSIT_FORCE, F_BETA, F_DP, F_DTAU, F_FORCE, F_MASK, F_VELOCITY,
     F_WALLS, F_WIDTH, M_MASS, M_MASS_SPEED2, M_MASS_U, M_MASS_V, M_NR2, M_NR3, M_VOLUME, MEAN_U, MEAN_V, MOMENT_COUNT,
-    OUTLET, P_BED_FRICTION, P_BED_STRESS, P_DAMPING, P_DAMPING_THRESHOLD, P_DX, P_DZ, P_EPSILON,
+    OUTLET, P_BED_FRICTION, P_BED_SLOPE, P_BED_STRESS, P_DAMPING, P_DAMPING_THRESHOLD, P_DX, P_DZ, P_EPSILON,
     P_FRICTION_FRACTION, P_GRAVITY, P_RESTITUTION, P_RHO_F, P_STRESS_BETA, P_STRESS_P, P_THETA_CP, PRESSURE,
     SAUTER, TAU, THETA, VARIANCE, WIDTH)
 from hfgpu.kernels.runtime import ti
@@ -141,9 +141,11 @@ def finish_cells(C: ti.template(), CD: ti.template(), copies: ti.i32, PR: ti.tem
 
 
 @ti.func
-def bed_strength_pass(C: ti.template(), PR: ti.template()):
-    """The overburden's bed friction per unit mass a_f of every cell into C[BED_STRENGTH], one thread per column
-    scanning down (closures.bed.column_strength; particle_ops_numpy.bed_strength); 0 with bed_stress "grain"."""
+def bed_pass(C: ti.template(), PR: ti.template()):
+    """One thread per column scanning down: the overburden's bed friction per unit mass a_f of every cell into
+    C[BED_STRENGTH] (closures.bed.column_strength; particle_ops_numpy.bed_strength; 0 with bed_stress "grain"),
+    and with bed_slope the loads of the slope into C[LOAD_TOP], C[LOAD_OWN] (closures.bed.column_load; not
+    written, and not read, without it)."""
     for i in range(C.shape[2]):
         if PR[P_BED_STRESS] > 0.0:
             bed.column_strength(C, i, PR[P_FRICTION_FRACTION], PR[P_DX], PR[P_RHO_F], PR[P_GRAVITY],
@@ -151,6 +153,8 @@ def bed_strength_pass(C: ti.template(), PR: ti.template()):
         else:
             for k in range(C.shape[1]):
                 C[BED_STRENGTH, k, i] = 0.0
+        if PR[P_BED_SLOPE] > 0.0:
+            bed.column_load(C, i, PR[P_FRICTION_FRACTION], PR[P_DX], PR[P_RHO_F], PR[P_GRAVITY])
 
 
 @ti.func
@@ -197,4 +201,4 @@ def finish_faces(C: ti.template(), F: ti.template(), D: ti.template(), copies: t
 
 
 __all__ = ["set_faces", "set_cells", "flags_pass", "load_faces", "load_pressure", "zero_copies", "finish_cells",
-           "bed_strength_pass", "stress_gradient", "finish_faces"]
+           "bed_pass", "stress_gradient", "finish_faces"]

@@ -15,7 +15,8 @@ Parcels (capacity ``cap``; the first ``n`` columns are in use):
 Grid (nz, nx cells):
     C (CELL_CHANNELS, nz, nx): width, open-cell mask, dynamic pressure, the scattered moments and the fields the
         parcels read (theta_p, mean velocity, velocity variance, Sauter radius, particle stress, damping rate),
-        outlet mask, the bed friction per unit mass of the overburden (hfgpu.kernels.closures.bed)
+        outlet mask, the bed friction per unit mass of the overburden and the loads of the bed's slope
+        (hfgpu.kernels.closures.bed)
     XF (FACE_CHANNELS, nz, nx+1) and ZF (FACE_CHANNELS, nz+1, nx): active-face mask, face width, fluid velocity,
         pressure and stress gradients, the sub-loop's mean interphase force F and implicit drag beta (Eq. 39)
     FLAGS (nz, nx) int32: stencil_flags
@@ -78,8 +79,8 @@ M_OWN_X = MOMENT_FIELDS.index("own_volume_x")
 M_OWN_Z = MOMENT_FIELDS.index("own_volume_z")
 MOMENT_COUNT = len(MOMENT_FIELDS)
 (WIDTH, CELL, PRESSURE, THETA, MEAN_U, MEAN_V, VARIANCE, SAUTER, TAU, DAMPING, OUTLET,
- BED_STRENGTH) = range(MOMENT_COUNT, MOMENT_COUNT + 12)
-CELL_CHANNELS = BED_STRENGTH + 1
+ BED_STRENGTH, LOAD_TOP, LOAD_OWN) = range(MOMENT_COUNT, MOMENT_COUNT + 14)
+CELL_CHANNELS = LOAD_OWN + 1
 # face channels (XF, ZF): the same for both face sets; F_WALLS masks the nodes the fluid velocity is read on (the
 # active faces and the walls, hfgpu.proppant.interpolation.velocity_nodes)
 F_MASK, F_WIDTH, F_VELOCITY, F_DP, F_DTAU, F_FORCE, F_BETA, F_WALLS = range(8)
@@ -91,7 +92,7 @@ DEPOSIT_FORCE, DEPOSIT_BETA = range(2)
 # z0, dx, dz, the fluid's density rho_f [kg/m^3] and viscosity mu_f [Pa s], gravity [m/s^2]
 PARAMS = ("x0", "z0", "dx", "dz", "theta_cp", "epsilon", "packing_restitution", "drag_law_code",
           "drag_re_coefficient", "bridging_factor", "drag_iterations", "bed_friction", "bed_stress_code",
-          "friction_volume_fraction",
+          "bed_slope", "friction_volume_fraction",
           "shields_deposition", "wall_friction_code", "rho_f", "mu_f", "gravity", "P_s", "beta", "restitution",
           "damping", "damping_threshold", "averaging_code")
 P_X0 = PARAMS.index("x0")
@@ -107,6 +108,7 @@ P_BRIDGING = PARAMS.index("bridging_factor")
 P_DRAG_ITERATIONS = PARAMS.index("drag_iterations")
 P_BED_FRICTION = PARAMS.index("bed_friction")
 P_BED_STRESS = PARAMS.index("bed_stress_code")
+P_BED_SLOPE = PARAMS.index("bed_slope")
 P_FRICTION_FRACTION = PARAMS.index("friction_volume_fraction")
 P_SHIELDS = PARAMS.index("shields_deposition")
 P_WALL_LAW = PARAMS.index("wall_friction_code")

@@ -34,7 +34,7 @@ from hfgpu.kernels.layout import (
     BRIDGED, CELL, DAMPING, DENSITY, DRAG, F_DP, F_DTAU, F_MASK, F_VELOCITY, F_WALLS, GONE, LAG_X, LAG_Z, MEAN_U,
     F_WIDTH, MEAN_V, OUTLET, P_BED_FRICTION, P_BRIDGING, P_DAMPING_THRESHOLD, P_DRAG_ITERATIONS, P_DRAG_LAW, P_DX, P_DZ,
     P_AVERAGING, P_EPSILON, P_FRICTION_FRACTION, P_GRAVITY, P_MU, P_PACKING_RESTITUTION, P_RE_COEFFICIENT, P_RHO_F,
-    P_SHIELDS,
+    P_BED_SLOPE, P_SHIELDS,
     P_THETA_CP, P_WALL_LAW, P_X0, P_Z0, PARTICLES, RADIUS, S_DAMPING, S_DPDX, S_DPDZ, S_DTDX, S_DTDZ, S_MEAN_U,
     S_MEAN_V, S_THETA, S_UF, S_VF, S_WIDTH, SEEN, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW, ST_SPEED,
     ST_VOLUME, STATE, SUSPENDED, THETA, U, V, WIDTH, X, Z)
@@ -354,10 +354,12 @@ def move(p: ti.i32, sx: ti.f64, sz: ti.f64, flag: ti.i32, P: ti.template(), dt: 
 @ti.func
 def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(), C: ti.template(),
                 FLAGS: ti.template(), dt: ti.f64, PR: ti.template()):
-    """After the drag solve of parcel p: bed friction (on_bed; a_f the larger of the own weight's and the own
-    cell's BED_STRENGTH, particle_ops_numpy.bed_friction), the threshold of motion on a bed surface
-    (deposited, with shields_deposition), bridging, the move, and the lags 1 - r of the implicit drag
-    (simulator.parcel_response)."""
+    """After the drag solve of parcel p: on a bed (on_bed), the slope's push (with bed_slope,
+    closures.bed.slope_acceleration; both it and the friction then over the drag's denominator only,
+    particle_ops_numpy.push), bed friction (a_f the larger of the own weight's and the own cell's
+    BED_STRENGTH, particle_ops_numpy.bed_friction) and the threshold of motion on a bed surface (deposited, with
+    shields_deposition, unless the slope's push exceeds a_f); bridging, the move, and the lags 1 - r of the
+    implicit drag (simulator.parcel_response)."""
     sx, sz = cell_coordinates(P, p, PR)
     flag = owner_flags(sx, sz, FLAGS)
     rho_f = PR[P_RHO_F]
@@ -369,8 +371,13 @@ def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(),
             k, i = owner(sx, sz)
             friction = ti.max(PR[P_BED_FRICTION] * ti.abs((1.0 - rho_f / P[DENSITY, p]) * gravity),
                               C[BED_STRENGTH, k, i])
+            slope = 0.0
+            if PR[P_BED_SLOPE] > 0.0:
+                slope = bed.slope_acceleration(sx, sz, P[DENSITY, p], C, PR[P_THETA_CP], PR[P_DX])
+                den = 1.0 + dt * W[DRAG, p]
+                P[U, p] += dt * slope / den
             P[U, p] = bed.bed_friction(P[U, p], friction, dt, den)
-            if PR[P_SHIELDS] > 0.0:
+            if PR[P_SHIELDS] > 0.0 and ti.abs(slope) <= friction:
                 if deposited(sx, sz, W[S_UF, p], W[S_WIDTH, p], P[RADIUS, p], P[DENSITY, p], C, dense, rho_f,
                              PR[P_MU], gravity, ti.cast(PR[P_WALL_LAW], ti.i32)):
                     P[U, p] = 0.0

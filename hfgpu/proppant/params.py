@@ -53,6 +53,10 @@ class MppicParams:
     least their own weight's): a bed n cells deep holds n times the drag at its base that its surface cell
     holds. Default "grain": the field-case and five-layer figures of the docs are measured with it ("overburden":
     docs/proppant-closures.md, "Bed friction").
+    bed_slope: the frictional pressure of the contact network pushes the grains resting on a bed down its slope
+    (hfgpu.kernels.closures.bed, slope): a_s = -(d p_f / dx) / (theta_cp rho_p), p_f the submerged weight per
+    unit area of the loaded cells above, so that a bed surface steeper than atan(bed_friction) sheds its surface
+    grains (the Coulomb angle of repose) and a released column slumps. false: no sideways push but Eq. 16's.
     averaging: the volume fraction a parcel sees in its drag and packing limiter (hfgpu.kernels.closures.averaging,
     OpenFOAM's AveragingMethods): "dual" = the bilinear deposit read back bilinearly; "basic" = its own cell's;
     "moment" = the linear function over its own cell with the first moments of the cell's parcels. Default
@@ -94,6 +98,7 @@ class MppicParams:
     damping_threshold: float = 0.5
     bed_friction: float = 0.543
     bed_stress: str = "grain"
+    bed_slope: bool = False
     averaging: str = "dual"
     friction_volume_fraction: float = 0.5
     wall_friction: str = "laminar"
@@ -131,7 +136,7 @@ class MppicParams:
         if isinstance(self.drag_iterations, bool) or not isinstance(self.drag_iterations, int) \
                 or self.drag_iterations < 1:
             raise bad("drag_iterations", "allowed: an integer >= 1")
-        for name in ("damping", "shields_deposition"):
+        for name in ("damping", "shields_deposition", "bed_slope"):
             if not isinstance(getattr(self, name), bool):
                 raise bad(name, "allowed: true or false")
         if not 0.0 <= self.damping_threshold <= 1.0:

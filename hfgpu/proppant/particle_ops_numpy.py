@@ -52,8 +52,8 @@ class GridFields:
     """Node fields the gather and push read: activity masks (and those of the fluid velocity, with the walls:
     interpolation.velocity_nodes), fluid velocities and gradients at faces, the cell
     fields theta_p, mean parcel velocity, damping rate and width (the push reads theta_p and width for its
-    walls and packing cap) and bed_strength, the bed friction per unit mass of the overburden a_f [m/s^2]
-    (hfgpu.kernels.closures.bed), and what the averaging (its name, ``averaging``) reads: the moments' S, S_x,
+    walls and packing cap), bed_strength, the bed friction per unit mass of the overburden a_f [m/s^2], and
+    the loads W_top, W_own [Pa] of the bed's slope (hfgpu.kernels.closures.bed; zeros without bed_slope), and what the averaging (its name, ``averaging``) reads: the moments' S, S_x,
     S_z and the cell volume dx dz w (hfgpu.kernels.closures.averaging). Built once per particle step by
     ``grid_fields``."""
 
@@ -75,6 +75,8 @@ class GridFields:
     width: np.ndarray
     free_grains: np.ndarray
     bed_strength: np.ndarray
+    load_top: np.ndarray
+    load_own: np.ndarray
     own_volume: np.ndarray
     own_volume_x: np.ndarray
     own_volume_z: np.ndarray
@@ -161,7 +163,8 @@ def grid_fields(frame: GridFrame, width: np.ndarray, u: np.ndarray, v: np.ndarra
                 moments: CellMoments, params: MppicParams, fluid_density: float, gravity: float) -> GridFields:
     """Node fields for the gather: pressure and stress (Eq. 16) gradients differenced to active faces
     (0 elsewhere), the damping rate 1/tau_D per cell (O'Rourke & Snider 2010 eq. 48), ``free_grains`` and the
-    overburden's bed friction per unit mass (closures.bed.bed_strength_numpy; 0 with bed_stress "grain")."""
+    overburden's bed friction per unit mass (closures.bed.bed_strength_numpy; 0 with bed_stress "grain") and
+    the slope's loads (closures.bed.bed_load_numpy; 0 without bed_slope)."""
     check_fluid(width, u, v, pressure)
     cell, xmask, zmask = active_nodes(width)
     tau = closures.particle_stress(moments.volume_fraction, params)
@@ -188,6 +191,7 @@ def grid_fields(frame: GridFrame, width: np.ndarray, u: np.ndarray, v: np.ndarra
                       damping_rate=damping * cell, width=np.ascontiguousarray(width, dtype=np.float64),
                       free_grains=free_grains(moments.volume_fraction, params),
                       bed_strength=bed_strength(frame, width, moments, params, fluid_density, gravity),
+                      **bed_load(frame, width, moments, params, fluid_density, gravity),
                       own_volume=moments.own_volume, own_volume_x=moments.own_volume_x,
                       own_volume_z=moments.own_volume_z,
                       cell_volume=frame.dx * frame.dz * np.where(width > 0.0, width, 0.0),
@@ -202,6 +206,29 @@ def bed_strength(frame: GridFrame, width: np.ndarray, moments: CellMoments, para
     return bed.bed_strength_numpy(moments.mass, moments.solid_volume, width, moments.volume_fraction,
                                   params.friction_volume_fraction, frame.dx, fluid_density, gravity,
                                   params.bed_friction)
+
+
+def bed_load(frame: GridFrame, width: np.ndarray, moments: CellMoments, params: MppicParams,
+             fluid_density: float, gravity: float) -> dict[str, np.ndarray]:
+    """load_top and load_own per cell with bed_slope (closures.bed.bed_load_numpy), zeros without it."""
+    if not params.bed_slope:
+        return {"load_top": np.zeros_like(moments.mass), "load_own": np.zeros_like(moments.mass)}
+    top, own = bed.bed_load_numpy(moments.mass, moments.solid_volume, width, moments.volume_fraction,
+                                  params.friction_volume_fraction, frame.dx, fluid_density, gravity)
+    return {"load_top": top, "load_own": own}
+
+
+def slope(parcels: Parcels, resting: np.ndarray, frame: GridFrame, fields: GridFields,
+          params: MppicParams) -> np.ndarray:
+    """The slope's push a_s per unit mass [m/s^2] of the parcels ``resting`` on a bed (closures.bed,
+    slope_acceleration_numpy), 0 for the others and without bed_slope."""
+    out = np.zeros(parcels.n)
+    if params.bed_slope and resting.any():
+        out[resting] = bed.slope_acceleration_numpy(
+            (parcels.x[resting] - frame.x0) / frame.dx, (parcels.z[resting] - frame.z0) / frame.dz,
+            parcels.density[resting], fields.load_top, fields.load_own, fields.volume_fraction, fields.width,
+            params.theta_cp, frame.dx)
+    return out
 
 
 def free_grains(volume_fraction: np.ndarray, params: MppicParams) -> np.ndarray:
@@ -311,10 +338,14 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     bounds the velocity relative to the cell's mean parcel velocity, which does not stop a stream of parcels
     that arrives together against a wall; the cap bounds every cell's theta_p by theta_cp plus one step's
     inflow, whatever the parcels' velocities.
-    Bed friction: where the parcel rests in or on a dense bed or on the floor (on_bed) its x velocity is
-    reduced by Coulomb friction (hfgpu.kernels.closures.bed, mu_b = bed_friction, on the normal stress
-    bed_stress names: ``bed_friction``) before the walls; with
-    shields_deposition, one on a bed surface below the threshold of motion (_deposited) stops along x.
+    Bed friction: where the parcel rests in or on a dense bed or on the floor (on_bed) its x velocity gains
+    the slope's push (with bed_slope, ``slope``) and is reduced by Coulomb friction
+    (hfgpu.kernels.closures.bed, mu_b = bed_friction, on the normal stress bed_stress names: ``bed_friction``)
+    before the walls, each as dt a / den; with bed_slope over the drag's 1 + dt D only: these contact forces
+    act on the skeleton, whose mean velocity the collision damping (which relaxes a grain towards its
+    cell's mean) must not hold back (at theta_p >= theta_cp its rate reaches 1e5-1e6 1/s, which froze a
+    packed cliff); with shields_deposition, one on a bed surface below the threshold of motion
+    (_deposited) stops along x unless |a_s| exceeds its friction (an avalanche).
     Bridging: where the width of the parcel's cell is below bridging_factor x 2 r the parcel is set to state 1
     with zero velocity and does not move; others get state 0. Gravity [m/s^2] acts along +z (depth).
     """
@@ -336,9 +367,14 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     v_new = v_new + packing_limiter_numpy(scale * seen.dtaudz, seen.mean_v - v_new, seen.dtaudz,
                                           params.packing_restitution)
     resting = on_bed(parcels.x, parcels.z, parcels.radius, frame, fields.width, fields.volume_fraction, params)
-    u_new = bed.bed_friction_numpy(u_new, resting, bed_friction(parcels, frame, fields, buoyant_g, params), dt, den)
+    friction = bed_friction(parcels, frame, fields, buoyant_g, params)
+    push_down = slope(parcels, resting, frame, fields, params)
+    contact = 1.0 + dt * drag if params.bed_slope else den
+    u_new = np.where(resting, u_new + dt * push_down / contact, u_new)
+    u_new = bed.bed_friction_numpy(u_new, resting, friction, dt, contact)
     u_new = np.where(_deposited(parcels.x, parcels.z, resting, seen, parcels.radius, rho_p, frame, fields, params,
-                                fluid_density, fluid_viscosity, gravity), 0.0, u_new)
+                                fluid_density, fluid_viscosity, gravity) & (np.abs(push_down) <= friction),
+                     0.0, u_new)
     bridged = seen.width < params.bridging_factor * 2.0 * parcels.radius
     u_new = np.where(bridged, 0.0, u_new)
     v_new = np.where(bridged, 0.0, v_new)

@@ -36,6 +36,31 @@ What presses the grain onto the bed (``bed_stress``, BED_STRESSES):
   gamma' w / (2 mu_w K) over a depth w / (2 mu_w K) (~2.5 w at mu_w = 0.5, K = 0.4), but the same face
   friction resists sliding along x, which is not counted either (docs/proppant-closures.md).
 
+Slope (``bed_slope``): the frictional normal stress of the contact network also pushes sideways. Taken
+isotropic (the frictional pressure p_f of Johnson & Jackson and Schaeffer, whose Coulomb bound is the shear
+strength above), its gradient along x is a force per unit volume -d p_f / dx on the skeleton, which a grain of
+density rho_p in a skeleton at close packing feels per unit mass as
+
+    a_s = -(d p_f / dx) / (theta_cp rho_p),      p_f(x, z) = W(x, z), the submerged weight per unit area above
+                                                  z in the loaded cells of the column at x.
+
+A loaded cell is a dense cell (theta_p >= friction_volume_fraction) or the loose cell on top of a dense cell or
+of a floor (a closed cell or the grid's edge below), the cell of the grains that rest on a bed (on_bed); a
+loose cell starts the column's load again. Within cell k of a column, W = W_top(k) + W_own(k) - (1 - zeta) G(k),
+G = W_own / min(theta_p / theta_cp, 1): the cell's grains packed at its bottom over a share f = min(theta_p /
+theta_cp, 1) of its height (zeta in [0, 1] the depth within the cell), W continued linearly above the
+surface of a partly filled cell (negative there: p_f = gamma (h - z) of the surface at height h), and into the
+empty open cell over a loaded one. d p_f / dx is differenced across the x-faces of the parcel's row at the
+parcel's depth, between open cells (0 across a closed cell or the grid's edge: a wall carries the stress), and
+interpolated linearly in x. On a bed surface sloping at angle alpha, p_f = theta_cp (rho_p - rho_f) g (h(x) -
+z), so a_s = g' tan alpha down the slope at every depth, the surface grains' too (the two columns' surfaces
+being at most a row apart), against bed friction mu_b g' (the surface grains, own weight) to
+n mu_b g' (n cells deep, "overburden"): a slope steeper than atan(mu_b) sheds its surface grains and a
+shallower one holds, the Coulomb (infinite-slope) angle of repose of a cohesionless material, tan alpha_r =
+tan phi (Terzaghi 1943, Theoretical Soil Mechanics, sec. 103; Nedderman 1992, Statics and Kinematics of
+Granular Materials, ch. 4). A grain so pushed is not held by the threshold of motion (an avalanche is not
+the flow's doing).
+
 Threshold of motion: a grain of diameter d on a bed surface is held where the Shields number (Shields 1936)
 of the bed shear stress is below the critical one of Soulsby & Whitehouse (1997, Proc. Pacific Coasts and
 Ports 1, eq. 7; Soulsby 1997, Dynamics of Marine Sands, eq. 77):
@@ -60,7 +85,7 @@ import numpy as np
 
 from hfgpu.kernels.closures.twin import ti
 from hfgpu.kernels.closures.wall_friction import wall_friction_factor, wall_friction_factor_numpy
-from hfgpu.kernels.layout import BED_STRENGTH, M_MASS, M_VOLUME, THETA, WIDTH
+from hfgpu.kernels.layout import BED_STRENGTH, LOAD_OWN, LOAD_TOP, M_MASS, M_VOLUME, THETA, WIDTH
 
 #: what presses a resting grain onto the bed (module docstring); the kernels' code is the index
 BED_STRESSES = ("grain", "overburden")
@@ -109,6 +134,141 @@ def column_strength(cells: ti.template(), i: ti.i32, dense: ti.f64, dx: ti.f64, 
         else:
             above = 0.0
         cells[BED_STRENGTH, k, i] = strength
+
+
+def bed_load_numpy(mass, volume, width, volume_fraction, dense, dx, fluid_density, gravity):
+    """(W_top, W_own) [Pa] per cell (nz, nx): the submerged weight per unit area of the loaded cells above the
+    cell's top in its column, and of the cell itself (module docstring, slope); both 0 in a cell not loaded."""
+    nz = mass.shape[0]
+    top = np.zeros_like(mass)
+    own = np.zeros_like(mass)
+    above = np.zeros(mass.shape[1])
+    for k in range(nz):
+        filled = (width[k] > 0.0) & (mass[k] > 0.0)
+        dense_k = filled & (volume_fraction[k] >= dense)
+        if k + 1 < nz:
+            support = (width[k + 1] <= 0.0) | ((volume_fraction[k + 1] >= dense) & (mass[k + 1] > 0.0))
+        else:
+            support = np.ones(mass.shape[1], dtype=bool)
+        loaded = dense_k | (filled & support)
+        weight = (mass[k] - fluid_density * volume[k]) * gravity / np.where(filled, dx * width[k], 1.0)
+        above = np.where(dense_k, above, 0.0)
+        top[k] = np.where(loaded, above, 0.0)
+        own[k] = np.where(loaded, weight, 0.0)
+        above = np.where(loaded, above + weight, 0.0)
+    return top, own
+
+
+def slope_acceleration_numpy(sx, sz, density, top, own, volume_fraction, width, theta_cp, dx):
+    """a_s [m/s^2] of parcels of density ``density`` at cell coordinates (sx, sz) inside the grid (cell (k, i)
+    spans [i - 1/2, i + 1/2) x [k - 1/2, k + 1/2)), from the loads of bed_load_numpy (module docstring, slope)."""
+    nz, nx = top.shape
+    k = np.floor(sz + 0.5).astype(np.int64)
+    i = np.floor(sx + 0.5).astype(np.int64)
+    xi = sx - i + 0.5
+    zeta = sz - k + 0.5
+
+    def packed(row, c):  # W_top + W_own and G = W_own / min(theta_p / theta_cp, 1) of cell (row, c)
+        fill = np.minimum(volume_fraction[row, c] / theta_cp, 1.0)
+        return top[row, c] + own[row, c], own[row, c] / np.where(fill > 0.0, fill, 1.0)
+
+    def load(col):  # W at the parcel's depth in column col, and whether the face to it is open
+        c = np.clip(col, 0, nx - 1)
+        inside = (col >= 0) & (col < nx)
+        base, unit = packed(k, c)
+        below = np.minimum(k + 1, nz - 1)
+        base_b, unit_b = packed(below, c)
+        surface_below = inside & (own[k, c] == 0.0) & (k + 1 < nz) & (own[below, c] != 0.0)
+        w = np.where(own[k, c] != 0.0, base - (1.0 - zeta) * unit,
+                     np.where(surface_below, base_b - unit_b - (1.0 - zeta) * unit_b, 0.0))
+        return np.where(inside, w, 0.0), inside & (width[k, c] > 0.0)
+
+    here, _ = load(i)
+    left, left_open = load(i - 1)
+    right, right_open = load(i + 1)
+    gradient = ((1.0 - xi) * np.where(left_open, here - left, 0.0)
+                + xi * np.where(right_open, right - here, 0.0)) / dx
+    return -gradient / (theta_cp * density)
+
+
+@ti.func
+def column_load(cells: ti.template(), i: ti.i32, dense: ti.f64, dx: ti.f64, fluid_density: ti.f64,
+                gravity: ti.f64):
+    """W_top and W_own of every cell of column i into cells[LOAD_TOP], cells[LOAD_OWN] (bed_load_numpy),
+    scanning down; the channels M_MASS, M_VOLUME, THETA and WIDTH are read."""
+    nz = cells.shape[1]
+    above = 0.0
+    for k in range(nz):
+        width = cells[WIDTH, k, i]
+        mass = cells[M_MASS, k, i]
+        filled = width > 0.0 and mass > 0.0
+        dense_k = filled and cells[THETA, k, i] >= dense
+        support = True
+        if k + 1 < nz:
+            support = cells[WIDTH, k + 1, i] <= 0.0 or (cells[THETA, k + 1, i] >= dense
+                                                       and cells[M_MASS, k + 1, i] > 0.0)
+        top = 0.0
+        own = 0.0
+        if not dense_k:
+            above = 0.0
+        if dense_k or (filled and support):
+            top = above
+            own = (mass - fluid_density * cells[M_VOLUME, k, i]) * gravity / (dx * width)
+            above = above + own
+        else:
+            above = 0.0
+        cells[LOAD_TOP, k, i] = top
+        cells[LOAD_OWN, k, i] = own
+
+
+@ti.func
+def packed(cells: ti.template(), k: ti.i32, col: ti.i32, theta_cp: ti.f64):
+    """W_top + W_own and G = W_own / min(theta_p / theta_cp, 1) of cell (k, col) (slope_acceleration_numpy)."""
+    fill = ti.min(cells[THETA, k, col] / theta_cp, 1.0)
+    own = cells[LOAD_OWN, k, col]
+    return cells[LOAD_TOP, k, col] + own, own / (fill if fill > 0.0 else 1.0)
+
+
+@ti.func
+def load_at(cells: ti.template(), k: ti.i32, col: ti.i32, zeta: ti.f64, theta_cp: ti.f64) -> ti.f64:
+    """W at depth zeta within cell (k, col) (slope_acceleration_numpy's load); 0 outside the grid."""
+    w = 0.0
+    if col >= 0 and col < cells.shape[2]:
+        if cells[LOAD_OWN, k, col] != 0.0:
+            base, unit = packed(cells, k, col, theta_cp)
+            w = base - (1.0 - zeta) * unit
+        elif k + 1 < cells.shape[1]:
+            if cells[LOAD_OWN, k + 1, col] != 0.0:
+                base, unit = packed(cells, k + 1, col, theta_cp)
+                w = base - unit - (1.0 - zeta) * unit
+    return w
+
+
+@ti.func
+def open_cell(cells: ti.template(), k: ti.i32, col: ti.i32) -> ti.i32:
+    """Cell (k, col) is inside the grid and open."""
+    out = 0
+    if col >= 0 and col < cells.shape[2]:
+        out = ti.cast(cells[WIDTH, k, col] > 0.0, ti.i32)
+    return out
+
+
+@ti.func
+def slope_acceleration(sx: ti.f64, sz: ti.f64, density: ti.f64, cells: ti.template(), theta_cp: ti.f64,
+                       dx: ti.f64) -> ti.f64:
+    """a_s of a parcel at cell coordinates (sx, sz) inside the grid (slope_acceleration_numpy), from the
+    channels LOAD_TOP, LOAD_OWN, THETA and WIDTH of ``cells``."""
+    k = ti.cast(ti.floor(sz + 0.5), ti.i32)
+    i = ti.cast(ti.floor(sx + 0.5), ti.i32)
+    xi = sx - i + 0.5
+    zeta = sz - k + 0.5
+    here = load_at(cells, k, i, zeta, theta_cp)
+    gradient = 0.0
+    if open_cell(cells, k, i - 1):
+        gradient += (1.0 - xi) * (here - load_at(cells, k, i - 1, zeta, theta_cp))
+    if open_cell(cells, k, i + 1):
+        gradient += xi * (load_at(cells, k, i + 1, zeta, theta_cp) - here)
+    return -gradient / dx / (theta_cp * density)
 
 
 def bed_shear_stress_numpy(speed, width, fluid_density, viscosity, code: int):

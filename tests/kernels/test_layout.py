@@ -29,7 +29,7 @@ PARAM_SLOTS = {"P_X0": "x0", "P_Z0": "z0", "P_DX": "dx", "P_DZ": "dz", "P_THETA_
                "P_DRAG_LAW": "drag_law_code", "P_RE_COEFFICIENT": "drag_re_coefficient",
                "P_BRIDGING": "bridging_factor", "P_DRAG_ITERATIONS": "drag_iterations",
                "P_BED_FRICTION": "bed_friction", "P_BED_STRESS": "bed_stress_code",
-               "P_FRICTION_FRACTION": "friction_volume_fraction",
+               "P_BED_SLOPE": "bed_slope", "P_FRICTION_FRACTION": "friction_volume_fraction",
                "P_SHIELDS": "shields_deposition", "P_WALL_LAW": "wall_friction_code", "P_RHO_F": "rho_f",
                "P_MU": "mu_f", "P_GRAVITY": "gravity", "P_STRESS_P": "P_s", "P_STRESS_BETA": "beta",
                "P_RESTITUTION": "restitution", "P_DAMPING": "damping", "P_DAMPING_THRESHOLD": "damping_threshold",
@@ -85,9 +85,9 @@ def test_moment_channels_index_the_sums_by_name():
 
 
 def test_cell_channels_follow_the_moments():
-    """The cell channels WIDTH ... BED_STRENGTH come after the MOMENT_COUNT moment sums, each once."""
+    """The cell channels WIDTH ... LOAD_OWN come after the MOMENT_COUNT moment sums, each once."""
     names = ("WIDTH", "CELL", "PRESSURE", "THETA", "MEAN_U", "MEAN_V", "VARIANCE", "SAUTER", "TAU", "DAMPING",
-             "OUTLET", "BED_STRENGTH")
+             "OUTLET", "BED_STRENGTH", "LOAD_TOP", "LOAD_OWN")
     assert [getattr(L, n) for n in names] == list(range(L.MOMENT_COUNT, L.CELL_CHANNELS))
 
 
@@ -96,7 +96,8 @@ def distinctive_params() -> MppicParams:
     return dataclasses.replace(
         MppicParams(), theta_cp=0.61, P_s=4.5, beta=2.5, epsilon=3e-7, restitution=0.85, drag_law="snider",
         drag_re_coefficient=0.17, bridging_factor=2.3, drag_iterations=5, packing_restitution=0.1, damping=False,
-        damping_threshold=0.45, bed_friction=0.6, bed_stress="grain", friction_volume_fraction=0.52,
+        damping_threshold=0.45, bed_friction=0.6, bed_stress="grain", bed_slope=True,
+        friction_volume_fraction=0.52,
         wall_friction="dean", shields_deposition=False)
 
 

@@ -51,11 +51,12 @@ def close(a, b, rtol=RTOL):
     np.testing.assert_allclose(a, b, rtol=0, atol=rtol * scale)
 
 
-@pytest.mark.parametrize("drag_law, theta_cp, shields, private", [
-    ("wen-yu", 0.6, None, True), ("snider", 0.6, None, True), ("wen-yu", 0.045, None, True),
-    ("wen-yu", 0.6, "laminar", True), ("wen-yu", 0.6, "dean", True), ("wen-yu", 0.6, None, False),
-    ("wen-yu", 0.045, None, False)])
-def test_taichi_matches_numpy(drag_law, theta_cp, shields, private):
+@pytest.mark.parametrize("drag_law, theta_cp, shields, private, slope", [
+    ("wen-yu", 0.6, None, True, False), ("snider", 0.6, None, True, False), ("wen-yu", 0.045, None, True, False),
+    ("wen-yu", 0.6, "laminar", True, False), ("wen-yu", 0.6, "dean", True, False),
+    ("wen-yu", 0.6, None, False, False), ("wen-yu", 0.045, None, False, False), ("wen-yu", 0.045, None, True, True),
+    ("wen-yu", 0.6, "laminar", True, True), ("wen-yu", 0.045, None, False, True)])
+def test_taichi_matches_numpy(drag_law, theta_cp, shields, private, slope):
     """Two sub-steps of each engine from the same parcels: positions, velocities, states, the sub-loop's face
     forces and implicit-drag coefficients, and the moments after it agree to 1e-12. With theta_cp = 0.045
     about half of the cells count as packed, so the packing cap of the push acts, and friction_volume_fraction
@@ -63,12 +64,13 @@ def test_taichi_matches_numpy(drag_law, theta_cp, shields, private):
     shields_deposition on with that wall-friction law, friction_volume_fraction 0.035 (about half the cells
     dense: many parcels on a bed surface) and fluid velocities x 8 (gap Re up to ~2000), so that some surface
     parcels are below the threshold of motion and some above. ``private`` False: the GPU's deposits (blocks of
-    64 parcels adding into one grid with atomics) on the CPU."""
+    64 parcels adding into one grid with atomics) on the CPU. ``slope``: bed_slope on (the slope's loads and
+    push, and the avalanche that the threshold of motion does not hold)."""
     frame, width, parcels, fluid = random_case()
     fraction = 0.03 if theta_cp < 0.1 else 0.035 if shields else 0.5
     params = MppicParams(drag_law=drag_law, P_s=100.0, damping_threshold=0.0, theta_cp=theta_cp,
                          friction_volume_fraction=fraction, shields_deposition=shields is not None,
-                         wall_friction=shields or "laminar")
+                         wall_friction=shields or "laminar", bed_slope=slope)
     if shields:
         fluid = {**fluid, "u": 8.0 * fluid["u"]}
     a, b = parcels.copy(), parcels.copy()
