@@ -84,9 +84,9 @@ def mppic_lines(settings) -> str:
     return "\n".join(f"{k.strip()} = {v.strip()}" for k, v in (s.split("=", 1) for s in settings))
 
 
-def scene_head(end: float, fluid: str, kind: str, length: float, height: float) -> str:
+def scene_head(end: float, fluid: str, kind: str, length: float, height: float, cell: float = DZ) -> str:
     """The scene text the three set-ups share: proppant only to ``end`` [s], seed 1, ``fluid`` ([fluid] lines),
-    cells of DZ, a ``kind`` ("slot" or "box") of ``length`` x ``height`` [m] and gap W."""
+    cells of ``cell`` [m], a ``kind`` ("slot" or "box") of ``length`` x ``height`` [m] and gap W."""
     return f"""
 [run]
 end_time = "{end} s"
@@ -95,7 +95,7 @@ seed = 1
 [fluid]
 {fluid}
 [mesh]
-cell_size = "{DZ} m"
+cell_size = "{cell} m"
 [output]
 every = "1 s"
 [geometry]
@@ -190,21 +190,22 @@ def measure(shields: float, start: float = 0.5, end: float = 1.5, extra: str = "
     return r
 
 
-def pile_scene_text(end: float, rest: float = 0.0, solid_rate: float = 5e-7, extra: str = "") -> str:
+def pile_scene_text(end: float, rest: float = 0.0, solid_rate: float = 5e-7, extra: str = "",
+                    cell: float = DZ) -> str:
     rest_line = f', {{ until = "{end + rest} s", rate = "0 m**3/s" }}' if rest > 0.0 else ""
-    return scene_head(end + rest, 'viscosity = "1 cP"', "slot", PILE_L, PILE_H) + f"""
+    return scene_head(end + rest, 'viscosity = "1 cP"', "slot", PILE_L, PILE_H, cell) + f"""
 [[geometry.inlets]]
 kind = "point"
-x = "{PILE_L / 2 + DZ / 2} m"
-depth = "{DZ / 2} m"
+x = "{PILE_L / 2 + cell / 2} m"
+depth = "{cell / 2} m"
 [[geometry.outlets]]
 kind = "point"
-x = "{DZ / 2} m"
-depth = "{DZ / 2} m"
+x = "{cell / 2} m"
+depth = "{cell / 2} m"
 [[geometry.outlets]]
 kind = "point"
-x = "{PILE_L - DZ / 2} m"
-depth = "{DZ / 2} m"
+x = "{PILE_L - cell / 2} m"
+depth = "{cell / 2} m"
 [injection]
 schedule = [{{ until = "{end} s", rate = "{solid_rate / 0.2} m**3/s", proppant = "sand", volume_fraction = 0.2 }}{rest_line}]
 [[proppant]]
@@ -254,16 +255,16 @@ def flank_angles(heights: np.ndarray, dx: float = DZ) -> tuple[float, float, flo
     return top, angles[0], angles[1]
 
 
-def pour(end: float = 8.0, extra: str = "", quiet: bool = False, rest: float = 0.0) -> dict:
-    """Pour the pile for ``end`` seconds and let it rest ``rest`` seconds more (no flow); its surface, flank
-    angles and the fastest grain in it at the end."""
-    sim = ProppantSimulation(proppant_engine_setup(load_scene(pile_scene_text(end, rest, extra=extra))))
+def pour(end: float = 8.0, extra: str = "", quiet: bool = False, rest: float = 0.0, cell: float = DZ) -> dict:
+    """Pour the pile for ``end`` seconds on cells of ``cell`` [m] and let it rest ``rest`` seconds more (no
+    flow); its surface, flank angles and the fastest grain in it at the end."""
+    sim = ProppantSimulation(proppant_engine_setup(load_scene(pile_scene_text(end, rest, extra=extra, cell=cell))))
     end = end + rest
     while sim.time < end - 1e-9:
         sim.step(limit=end - sim.time)
     theta = sim.moments.volume_fraction
-    heights = surface(theta, 0.5 * sim.params.theta_cp)
-    top, left, right = flank_angles(heights)
+    heights = surface(theta, 0.5 * sim.params.theta_cp, cell)
+    top, left, right = flank_angles(heights, cell)
     p = sim.parcels
     in_pile = p.z > PILE_H - top
     r = {"end": end, "parcels": p.n, "peak": top, "left": left, "right": right, "angle": 0.5 * (left + right),
@@ -323,6 +324,7 @@ def main() -> None:
     parser.add_argument("--start", type=float, default=0.5)
     parser.add_argument("--end", type=float, default=None)
     parser.add_argument("--rest", type=float, default=0.0, help="repose: seconds at rest after the pour")
+    parser.add_argument("--cell", type=float, default=DZ, help="repose: cell size [m]")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="an [mppic] key")
     args = parser.parse_args()
     extra = mppic_lines(args.set)
@@ -331,7 +333,7 @@ def main() -> None:
         for s in args.shields:
             measure(s, args.start, args.end or 1.5, extra)
     elif args.case == "repose":
-        pour(args.end or 8.0, extra, rest=args.rest)
+        pour(args.end or 8.0, extra, rest=args.rest, cell=args.cell)
     else:
         collapse(args.end or 3.0, extra=extra)
     print(f"wall {time.perf_counter() - t0:.0f} s")

@@ -340,11 +340,14 @@ def move(p: ti.i32, sx: ti.f64, sz: ti.f64, flag: ti.i32, P: ti.template(), dt: 
     szn = (zn - PR[P_Z0]) / PR[P_DZ]
     stays = ti.floor(sxn + 0.5) == ti.floor(sx + 0.5) and ti.floor(szn + 0.5) == ti.floor(sz + 0.5)
     if not (stays and flag & QUIET):
-        if blocked(sx, sz, sxn, sz, C, theta_cp, dense, gap):
+        own = 0.0
+        if PR[P_BED_SLOPE] > 0.0:
+            own = solid_volume(P, p) / (PR[P_DX] * PR[P_DZ])
+        if blocked(sx, sz, sxn, sz, C, theta_cp, dense, gap, own):
             xn = P[X, p]
             sxn = sx
             P[U, p] = 0.0
-        if blocked(sxn, sz, sxn, szn, C, theta_cp, dense, gap):
+        if blocked(sxn, sz, sxn, szn, C, theta_cp, dense, gap, own):
             zn = P[Z, p]
             P[V, p] = 0.0
     P[X, p] = xn

@@ -332,7 +332,8 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     hfgpu.kernels.closures.particle_stress).
     Walls, per component (x first): a move that would leave the grid, enter a closed cell, enter another cell
     narrower than the parcel's bridging width (bridging_factor x 2 r), or raise the
-    parcel's bilinear weight on a cell whose theta_p (this step's scatter) is already >= theta_cp, or approach a
+    parcel's bilinear weight on a cell whose theta_p (this step's scatter, less the parcel's own deposit with
+    bed_slope) is already >= theta_cp, or approach a
     wall within the half cell next to it when the parcel's own cell is dense (hfgpu.kernels.closures.walls),
     is cancelled and that velocity component set to 0 (inelastic stop). The last rule is our packing cap: Snider's limiter
     bounds the velocity relative to the cell's mean parcel velocity, which does not stop a stream of parcels
@@ -380,13 +381,14 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     v_new = np.where(bridged, 0.0, v_new)
     x_try = parcels.x + dt * u_new
     gap = params.bridging_factor * 2.0 * parcels.radius
+    own = parcels.solid_volume() if params.bed_slope else None
     blocked = blocked_numpy(parcels.x, parcels.z, x_try, parcels.z, frame, fields.width, fields.cell_mask,
-                            fields.volume_fraction, params.theta_cp, params.friction_volume_fraction, gap)
+                            fields.volume_fraction, params.theta_cp, params.friction_volume_fraction, gap, own)
     x_new = np.where(blocked, parcels.x, x_try)
     u_new = np.where(blocked, 0.0, u_new)
     z_try = parcels.z + dt * v_new
     blocked = blocked_numpy(x_new, parcels.z, x_new, z_try, frame, fields.width, fields.cell_mask,
-                            fields.volume_fraction, params.theta_cp, params.friction_volume_fraction, gap)
+                            fields.volume_fraction, params.theta_cp, params.friction_volume_fraction, gap, own)
     z_new = np.where(blocked, parcels.z, z_try)
     v_new = np.where(blocked, 0.0, v_new)
     parcels.x[:] = x_new

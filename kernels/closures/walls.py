@@ -11,7 +11,10 @@ stop; the push applies the rules per component, x first, then z) where it
   - raises the parcel's bilinear weight (Eq. 37) on a cell whose theta_p (Eq. 38, this step's scatter) is
     already >= theta_cp: the packing cap. Snider's limiter (particle_stress) bounds the velocity relative to
     the cell's mean parcel velocity, which does not stop a stream of parcels that arrives together against a
-    wall; the cap bounds every cell's theta_p by theta_cp plus one step's inflow, whatever the velocities;
+    wall; the cap bounds every cell's theta_p by theta_cp plus one step's inflow, whatever the velocities.
+    With ``own`` (bed_slope), a cell is judged without the parcel's own deposit, theta_p - I_old n V_p / (dx dz
+    w) (I_old its weight on that cell before the move): the grains of a cliff sitting at their column's face
+    made their own cells packed and could never slide off (docs/validation.md, "Angle of repose");
   - heads for a wall (domain edge or closed cell) within the half cell next to it while its own cell is dense,
     theta_p >= dense (friction_volume_fraction: a contact network, as for bed friction). There the bilinear
     weights no longer change (the wall's node is inactive), so the move changes no grid field: neither the
@@ -31,18 +34,20 @@ from __future__ import annotations
 import numpy as np
 
 from hfgpu.kernels.closures.twin import Deferred, ti
-from hfgpu.kernels.layout import CELL, THETA
+from hfgpu.kernels.layout import CELL, THETA, WIDTH
 from hfgpu.kernels.stencil_numpy import owning_cell, weights
 
 stencil = Deferred("hfgpu.kernels.stencil")
 
 
-def blocked_numpy(x, z, x_try, z_try, frame, width, cell_mask, volume_fraction, theta_cp, dense, gap):
+def blocked_numpy(x, z, x_try, z_try, frame, width, cell_mask, volume_fraction, theta_cp, dense, gap,
+                  own=None):
     """True where the move (x, z) -> (x_try, z_try) leaves the grid, enters a closed cell, enters another cell
     narrower than ``gap`` (the parcel's bridging width, bridging_factor x 2 r), raises the bilinear weight
     (Eq. 37) of the parcel on a cell whose theta_p (``volume_fraction``, this step's scatter) is already
-    >= theta_cp, or heads for a wall from a cell with theta_p >= ``dense`` (toward_wall_dense_numpy); module
-    docstring. ``width``, ``cell_mask`` (the active cell nodes) and ``volume_fraction`` are (nz, nx)."""
+    >= theta_cp (less the parcel's own deposit where ``own``, its solid volume n V_p [m^3], is given), or heads
+    for a wall from a cell with theta_p >= ``dense`` (toward_wall_dense_numpy); module docstring. ``width``,
+    ``cell_mask`` (the active cell nodes) and ``volume_fraction`` are (nz, nx)."""
     k, i, inside = owning_cell(x_try, z_try, frame, width.shape)
     k_old, i_old, _ = owning_cell(x, z, frame, width.shape)
     narrow = ((k != k_old) | (i != i_old)) & (width[k, i] < gap)
@@ -50,7 +55,11 @@ def blocked_numpy(x, z, x_try, z_try, frame, width, cell_mask, volume_fraction, 
     k1, i1, w1 = weights(x_try, z_try, frame, "cell", cell_mask)
     same = (k1[:, :, None] == k0[:, None, :]) & (i1[:, :, None] == i0[:, None, :])
     before = np.sum(w0[:, None, :] * same, axis=2)
-    packed = volume_fraction[k1, i1] >= theta_cp
+    theta = volume_fraction[k1, i1]
+    if own is not None:
+        theta = theta - before * (own / (frame.dx * frame.dz))[:, None] / np.where(width[k1, i1] > 0.0,
+                                                                                  width[k1, i1], 1.0)
+    packed = theta >= theta_cp
     return ~inside | (width[k, i] <= 0.0) | narrow | np.any(packed & (w1 > before), axis=1) \
         | toward_wall_dense_numpy(x, z, x_try, z_try, frame, width, volume_fraction, dense)
 
@@ -81,10 +90,11 @@ def toward_wall_dense_numpy(x, z, x_try, z_try, frame, width, volume_fraction, d
 
 @ti.func
 def blocked(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.template(), theta_cp: ti.f64,
-            dense: ti.f64, gap: ti.f64) -> ti.i32:
+            dense: ti.f64, gap: ti.f64, own: ti.f64) -> ti.i32:
     """The move (sx, sz) -> (sxn, szn) (cell coordinates) leaves the grid, enters a closed cell, enters another
     cell narrower than ``gap`` (the parcel's bridging width, bridging_factor x 2 r), raises the parcel's bilinear
-    weight on a cell with theta_p >= theta_cp, or heads for a wall from a cell with theta_p >= dense
+    weight on a cell with theta_p >= theta_cp (less own x its old weight there / the cell's width: ``own`` = n V_p
+    / (dx dz) [m] with bed_slope, else 0), or heads for a wall from a cell with theta_p >= dense
     (friction_volume_fraction; blocked_numpy)."""
     out = 1
     width = stencil.owner_width(sxn, szn, cells)
@@ -96,7 +106,7 @@ def blocked(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.template
             if k0 != k1 or i0 != i1:
                 out = 1
         if out == 0 and packed_near(sxn, szn, cells, theta_cp):
-            out = packed_gain(sx, sz, sxn, szn, cells, theta_cp)
+            out = packed_gain(sx, sz, sxn, szn, cells, theta_cp, own)
         if out == 0:
             out = toward_wall_dense(sx, sz, sxn, szn, cells, dense)
     return out
@@ -136,8 +146,10 @@ def packed_near(sx: ti.f64, sz: ti.f64, cells: ti.template(), theta_cp: ti.f64) 
 
 
 @ti.func
-def packed_gain(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.template(), theta_cp: ti.f64) -> ti.i32:
-    """Whether the move raises the parcel's bilinear weight on a cell with theta_p >= theta_cp."""
+def packed_gain(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.template(), theta_cp: ti.f64,
+                own: ti.f64) -> ti.i32:
+    """Whether the move raises the parcel's bilinear weight on a cell with theta_p - own x its old weight there
+    / the cell's width >= theta_cp (blocked)."""
     out = 0
     k0, i0, w0 = stencil.bilinear(sx, sz, cells, CELL, False)
     k1, i1, w1 = stencil.bilinear(sxn, szn, cells, CELL, False)
@@ -150,6 +162,9 @@ def packed_gain(sx: ti.f64, sz: ti.f64, sxn: ti.f64, szn: ti.f64, cells: ti.temp
                         for d in ti.static(range(2)):
                             if k0 + c == k1 + a and i0 + d == i1 + b:
                                 before += w0[2 * c + d]
-                    if w1[2 * a + b] > before:
+                    theta = cells[THETA, k1 + a, i1 + b]
+                    if own > 0.0:
+                        theta = theta - before * own / cells[WIDTH, k1 + a, i1 + b]
+                    if w1[2 * a + b] > before and theta >= theta_cp:
                         out = 1
     return out

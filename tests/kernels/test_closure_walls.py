@@ -22,11 +22,11 @@ FRAME = SimpleNamespace(x0=0.1, z0=-0.2, dx=0.5, dz=0.25)
 
 
 @ti.kernel
-def _blocked(x: F1, z: F1, xn: F1, zn: F1, gap: F1, C: F3, out: I1, x0: ti.f64, z0: ti.f64, dx: ti.f64,
-             dz: ti.f64, theta_cp: ti.f64, dense: ti.f64):
+def _blocked(x: F1, z: F1, xn: F1, zn: F1, gap: F1, own: F1, C: F3, out: I1, x0: ti.f64, z0: ti.f64,
+             dx: ti.f64, dz: ti.f64, theta_cp: ti.f64, dense: ti.f64):
     for p in x:
         out[p] = walls.blocked((x[p] - x0) / dx, (z[p] - z0) / dz, (xn[p] - x0) / dx, (zn[p] - z0) / dz, C,
-                               theta_cp, dense, gap[p])
+                               theta_cp, dense, gap[p], own[p] / (dx * dz))
 
 
 def _grid():
@@ -72,19 +72,20 @@ def _moves(shape, n=60000):
     return x, z, x + dsx * FRAME.dx, z + dsz * FRAME.dz, gap
 
 
-def _taichi(x, z, xn, zn, gap, width, theta, theta_cp, dense):
+def _taichi(x, z, xn, zn, gap, width, theta, theta_cp, dense, own=None):
     C = np.zeros((L.CELL_CHANNELS, *width.shape))
     C[L.WIDTH] = width
     C[L.CELL] = (width > 0.0).astype(np.float64)
     C[L.THETA] = theta
     out = np.empty(x.shape, dtype=np.int32)
-    _blocked(x, z, xn, zn, gap, C, out, FRAME.x0, FRAME.z0, FRAME.dx, FRAME.dz, theta_cp, dense)
+    _blocked(x, z, xn, zn, gap, np.zeros_like(x) if own is None else own, C, out, FRAME.x0, FRAME.z0, FRAME.dx,
+             FRAME.dz, theta_cp, dense)
     return out.astype(bool)
 
 
-def _numpy(x, z, xn, zn, gap, width, theta, theta_cp, dense):
+def _numpy(x, z, xn, zn, gap, width, theta, theta_cp, dense, own=None):
     return walls.blocked_numpy(x, z, xn, zn, FRAME, width, (width > 0.0).astype(np.float64), theta, theta_cp,
-                               dense, gap)
+                               dense, gap, own)
 
 
 def test_twin_matches_numpy_each_rule():
@@ -114,3 +115,21 @@ def test_twin_matches_numpy_each_rule():
         assert alone.sum() >= 10, name
     assert np.array_equal(got["all"], np.logical_or.reduce(list(rules.values())))
     assert 0 < got["all"].sum() < x.size
+
+
+def test_packing_cap_without_the_parcels_own_deposit():
+    """With ``own`` (bed_slope) a packed cell is judged without the moving parcel's own deposit, theta_p - I_old
+    n V_p / (dx dz w): the twin matches the reference move by move; it blocks a subset of what the plain cap
+    blocks, and lets through some moves the plain cap stops (a parcel whose own weight makes a cell packed);
+    own = 0 is the plain cap."""
+    width, theta = _grid()
+    theta = np.where(width > 0.0, np.maximum(theta, np.random.default_rng(5).uniform(0.55, 0.7, theta.shape)), 0.0)
+    x, z, xn, zn, gap = _moves(width.shape)
+    own = np.random.default_rng(7).uniform(0.0, 6e-5, x.size)  # up to 0.1 of a cell's volume, 6.25e-4 m^3
+    inf = np.inf
+    plain = _numpy(x, z, xn, zn, 0.0 * gap, width, theta, THETA_CP, inf)
+    want = _numpy(x, z, xn, zn, 0.0 * gap, width, theta, THETA_CP, inf, own)
+    have = _taichi(x, z, xn, zn, 0.0 * gap, width, theta, THETA_CP, inf, own)
+    assert np.array_equal(want, have)
+    assert not (want & ~plain).any() and (plain & ~want).sum() >= 100
+    assert np.array_equal(_numpy(x, z, xn, zn, 0.0 * gap, width, theta, THETA_CP, inf, 0.0 * own), plain)
