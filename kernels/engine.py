@@ -95,7 +95,7 @@ def substep(P: F2, S: I2, W: F2, C: F3, XF: F3, ZF: F3, FLAGS: I2, CD: F4, XD: F
     particles.gather_pass(P, S, W, n, C, XF, ZF, FLAGS, PR, step == 0)
     particles.push_pass(P, S, W, n, C, FLAGS, h, PR)
     ST[ST_SPEED] = 0.0
-    particles.exchange_pass(P, S, W, n, C, XF, ZF, FLAGS, XD, ZD, BS, blocks, private, PR, ST, step)
+    particles.exchange_pass(P, S, W, n, C, XF, ZF, XD, ZD, BS, blocks, private, PR, ST, step)
     grid.finish_faces(C, XF, XD, copies, substeps, step == 0, PR, 1)
     grid.finish_faces(C, ZF, ZD, copies, substeps, step == 0, PR, 0)
     if ti.static(private):

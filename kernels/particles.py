@@ -427,7 +427,7 @@ def finite(a: ti.f64) -> ti.i32:
 
 @ti.func
 def exchange_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i32, C: ti.template(),
-                  XF: ti.template(), ZF: ti.template(), FLAGS: ti.template(), XD: ti.template(), ZD: ti.template(),
+                  XF: ti.template(), ZF: ti.template(), XD: ti.template(), ZD: ti.template(),
                   BS: ti.template(), blocks: ti.i32, private: ti.template(), PR: ti.template(), ST: ti.template(),
                   step: ti.i32):
     """Face sums (numerators of Eq. 39) of the drag n rho_p V_p D (u_f - u_p) and of the implicit drag
@@ -456,7 +456,6 @@ def exchange_pass(P: ti.template(), S: ti.template(), W: ti.template(), n: ti.i3
             for p in range(start, end):
                 if S[STATE, p] != GONE:
                     sx, sz = cell_coordinates(P, p, PR)
-                    flag = owner_flags(sx, sz, FLAGS)
                     k0, i0, w = volume_weights(sx, sz, 0.5, 0.0, XF, F_MASK, F_WIDTH)
                     k1, i1, w1 = volume_weights(sx, sz, 0.0, 0.5, ZF, F_MASK, F_WIDTH)
                     vol = solid_volume(P, p)
