@@ -357,9 +357,9 @@ def move(p: ti.i32, sx: ti.f64, sz: ti.f64, flag: ti.i32, P: ti.template(), dt: 
 @ti.func
 def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(), C: ti.template(),
                 FLAGS: ti.template(), dt: ti.f64, PR: ti.template()):
-    """After the drag solve of parcel p: on a bed (on_bed), the slope's push (with bed_slope,
-    closures.bed.slope_acceleration; both it and the friction then over the drag's denominator only,
-    particle_ops_numpy.push), bed friction (a_f the larger of the own weight's and the own cell's
+    """After the drag solve of parcel p: on a bed (on_bed), the slope's push (with bed_slope, in a dense cell or
+    below the threshold of motion, closures.bed.slope_acceleration; both it and the friction then over the
+    drag's denominator only, particle_ops_numpy.push and slope), bed friction (a_f the larger of the own weight's and the own cell's
     BED_STRENGTH, particle_ops_numpy.bed_friction) and the threshold of motion on a bed surface (deposited, with
     shields_deposition, unless the slope's push exceeds a_f); bridging, the move, and the lags 1 - r of the
     implicit drag (simulator.parcel_response)."""
@@ -376,7 +376,12 @@ def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(),
                               C[BED_STRENGTH, k, i])
             slope = 0.0
             if PR[P_BED_SLOPE] > 0.0:
-                slope = bed.slope_acceleration(sx, sz, P[DENSITY, p], C, PR[P_THETA_CP], PR[P_DX])
+                resting = 1
+                if C[THETA, k, i] < dense:
+                    resting = bed.held(W[S_UF, p], W[S_WIDTH, p], 2.0 * P[RADIUS, p], P[DENSITY, p], rho_f, PR[P_MU],
+                                       gravity, ti.cast(PR[P_WALL_LAW], ti.i32))
+                if resting:
+                    slope = bed.slope_acceleration(sx, sz, P[DENSITY, p], C, PR[P_THETA_CP], PR[P_DX])
                 den = 1.0 + dt * W[DRAG, p]
                 P[U, p] += dt * slope / den
             P[U, p] = bed.bed_friction(P[U, p], friction, dt, den)

@@ -59,7 +59,7 @@ class MppicParams:
     grains (the Coulomb angle of repose) and a released column slumps; the push and the bed friction are then
     taken over the drag's denominator only, and the packing cap judges a cell without the moving parcel's own
     deposit (closures.walls). false: no sideways push but Eq. 16's. Default false: with it the five-layer
-    base case has 46x the grains rising in dense cells (docs/validation.md, "Angle of repose").
+    base case has 14x the grains rising in dense cells (docs/validation.md, "Angle of repose").
     averaging: the volume fraction a parcel sees in its drag and packing limiter (hfgpu.kernels.closures.averaging,
     OpenFOAM's AveragingMethods): "dual" = the bilinear deposit read back bilinearly; "basic" = its own cell's;
     "moment" = the linear function over its own cell with the first moments of the cell's parcels. Default

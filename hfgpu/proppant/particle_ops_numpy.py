@@ -218,12 +218,21 @@ def bed_load(frame: GridFrame, width: np.ndarray, moments: CellMoments, params: 
     return {"load_top": top, "load_own": own}
 
 
-def slope(parcels: Parcels, resting: np.ndarray, frame: GridFrame, fields: GridFields,
-          params: MppicParams) -> np.ndarray:
-    """The slope's push a_s per unit mass [m/s^2] of the parcels ``resting`` on a bed (closures.bed,
-    slope_acceleration_numpy), 0 for the others and without bed_slope."""
+def slope(parcels: Parcels, resting: np.ndarray, seen: ParcelFluid, frame: GridFrame, fields: GridFields,
+          params: MppicParams, fluid_density: float, fluid_viscosity: float, gravity: float) -> np.ndarray:
+    """The slope's push a_s per unit mass [m/s^2] (closures.bed, slope_acceleration_numpy) of the parcels
+    ``resting`` on a bed that lie in a dense cell or, on a bed surface (own cell loose), are below the threshold
+    of motion of the flow they see (closures.bed.held_numpy, whatever shields_deposition: a grain the flow
+    entrains is carried by it, not resting on the slope); 0 for the others and without bed_slope."""
     out = np.zeros(parcels.n)
-    if params.bed_slope and resting.any():
+    if not params.bed_slope:
+        return out
+    k, i, _ = owning_cell(parcels.x, parcels.z, frame, fields.width.shape)
+    with np.errstate(divide="ignore", invalid="ignore"):  # a neutrally buoyant grain: never held
+        held = bed.held_numpy(seen.fluid_u, np.where(resting, seen.width, 1.0), 2.0 * parcels.radius,
+                              parcels.density, fluid_density, fluid_viscosity, gravity, params.wall_friction_code)
+    resting = resting & ((fields.volume_fraction[k, i] >= params.friction_volume_fraction) | held)
+    if resting.any():
         out[resting] = bed.slope_acceleration_numpy(
             (parcels.x[resting] - frame.x0) / frame.dx, (parcels.z[resting] - frame.z0) / frame.dz,
             parcels.density[resting], fields.load_top, fields.load_own, fields.volume_fraction, fields.width,
@@ -369,7 +378,7 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
                                           params.packing_restitution)
     resting = on_bed(parcels.x, parcels.z, parcels.radius, frame, fields.width, fields.volume_fraction, params)
     friction = bed_friction(parcels, frame, fields, buoyant_g, params)
-    push_down = slope(parcels, resting, frame, fields, params)
+    push_down = slope(parcels, resting, seen, frame, fields, params, fluid_density, fluid_viscosity, gravity)
     contact = 1.0 + dt * drag if params.bed_slope else den
     u_new = np.where(resting, u_new + dt * push_down / contact, u_new)
     u_new = bed.bed_friction_numpy(u_new, resting, friction, dt, contact)

@@ -58,8 +58,11 @@ being at most a row apart), against bed friction mu_b g' (the surface grains, ow
 n mu_b g' (n cells deep, "overburden"): a slope steeper than atan(mu_b) sheds its surface grains and a
 shallower one holds, the Coulomb (infinite-slope) angle of repose of a cohesionless material, tan alpha_r =
 tan phi (Terzaghi 1943, Theoretical Soil Mechanics, sec. 103; Nedderman 1992, Statics and Kinematics of
-Granular Materials, ch. 4). A grain so pushed is not held by the threshold of motion (an avalanche is not
-the flow's doing).
+Granular Materials, ch. 4). The push acts on the grains of dense cells and on the grains of a bed surface
+(own cell loose) that are below the threshold of motion (held): a grain the flow entrains is carried by it,
+not resting on the slope (without this, a moving suspension over a one-cell bed, counted as its load, lifted
+grains: docs/validation.md, "Angle of repose"). A grain so pushed harder than its friction is not held by the
+threshold of motion (an avalanche is not the flow's doing).
 
 Threshold of motion: a grain of diameter d on a bed surface is held where the Shields number (Shields 1936)
 of the bed shear stress is below the critical one of Soulsby & Whitehouse (1997, Proc. Pacific Coasts and
