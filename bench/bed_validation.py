@@ -105,23 +105,10 @@ height = "{height} m"
 """ + f'width = "{W} m"'
 
 
-def load_scene_text(speed: float, end: float, extra: str = "") -> str:
-    clear = H - ROWS * DZ
-    return scene_head(end, f'viscosity = "{MU * 1e3:g} cP"\ndensity = "{RHO_F:g} kg/m**3"', "slot", L, H) + f"""
-[[geometry.inlets]]
-kind = "segment"
-x = "1 mm"
-depth = "1 mm"
-x_end = "1 mm"
-depth_end = "{clear - 1e-3} m"
-[[geometry.outlets]]
-kind = "segment"
-x = "{L - 1e-3} m"
-depth = "1 mm"
-x_end = "{L - 1e-3} m"
-depth_end = "{clear - 1e-3} m"
-[injection]
-schedule = [{{ until = "100 s", rate = "{speed * clear * W} m**3/s" }}]
+def sand_lines(extra: str) -> str:
+    """The scene text the three set-ups end with: the sand (RHO_P, D) and the [mppic] table on the NumPy backend,
+    with ``extra`` [mppic] lines."""
+    return f"""
 [[proppant]]
 name = "sand"
 density = "{RHO_P:g} kg/m**3"
@@ -130,6 +117,28 @@ diameter = "{D} m"
 backend = "numpy"
 {extra}
 """
+
+
+def load_scene_text(speed: float, end: float, extra: str = "", length: float = L, viscosity: float = MU) -> str:
+    """The bed-load slot of ``length`` [m] (default L) with fluid of ``viscosity`` [Pa s] (default MU) entering
+    over the bed at mean ``speed`` [m/s] (``measure``; tests/proppant/test_bed_overburden.py uses it too)."""
+    clear = H - ROWS * DZ
+    fluid = f'viscosity = "{viscosity * 1e3:g} cP"\ndensity = "{RHO_F:g} kg/m**3"'
+    return scene_head(end, fluid, "slot", length, H) + f"""
+[[geometry.inlets]]
+kind = "segment"
+x = "1 mm"
+depth = "1 mm"
+x_end = "1 mm"
+depth_end = "{clear - 1e-3} m"
+[[geometry.outlets]]
+kind = "segment"
+x = "{length - 1e-3} m"
+depth = "1 mm"
+x_end = "{length - 1e-3} m"
+depth_end = "{clear - 1e-3} m"
+[injection]
+schedule = [{{ until = "100 s", rate = "{speed * clear * W} m**3/s" }}]""" + sand_lines(extra)
 
 
 def measure(shields: float, start: float = 0.5, end: float = 1.5, extra: str = "", every: float = 0.05,
@@ -207,15 +216,8 @@ kind = "point"
 x = "{PILE_L - cell / 2} m"
 depth = "{cell / 2} m"
 [injection]
-schedule = [{{ until = "{end} s", rate = "{solid_rate / 0.2} m**3/s", proppant = "sand", volume_fraction = 0.2 }}{rest_line}]
-[[proppant]]
-name = "sand"
-density = "2650 kg/m**3"
-diameter = "0.3 mm"
-[mppic]
-backend = "numpy"
-{extra}
-"""
+schedule = [{{ until = "{end} s", rate = "{solid_rate / 0.2} m**3/s", proppant = "sand", volume_fraction = 0.2 }}\
+{rest_line}]""" + sand_lines(extra)
 
 
 def surface(theta: np.ndarray, level: float, dz: float = DZ) -> np.ndarray:
@@ -278,15 +280,7 @@ def pour(end: float = 8.0, extra: str = "", quiet: bool = False, rest: float = 0
 
 
 def column_scene_text(end: float, extra: str = "") -> str:
-    return scene_head(end, 'viscosity = "1 cP"', "box", PILE_L, PILE_H) + f"""
-[[proppant]]
-name = "sand"
-density = "2650 kg/m**3"
-diameter = "0.3 mm"
-[mppic]
-backend = "numpy"
-{extra}
-"""
+    return scene_head(end, 'viscosity = "1 cP"', "box", PILE_L, PILE_H) + sand_lines(extra)
 
 
 def collapse(end: float = 3.0, columns: int = 4, rows: int = 12, extra: str = "", quiet: bool = False) -> dict:

@@ -252,19 +252,6 @@ def on_bed(sx: ti.f64, sz: ti.f64, radius: ti.f64, dz: ti.f64, C: ti.template(),
 
 
 @ti.func
-def deposited(sx: ti.f64, sz: ti.f64, fluid_u: ti.f64, width: ti.f64, radius: ti.f64, rho_p: ti.f64,
-              C: ti.template(), dense: ti.f64, rho_f: ti.f64, mu: ti.f64, gravity: ti.f64,
-              wall_law: ti.i32) -> ti.i32:
-    """For a parcel on a bed (on_bed): its own cell is loose (theta_p < dense) and the grain is below the
-    threshold of motion (closures.bed.held; particle_ops_numpy._deposited)."""
-    out = 0
-    k, i = owner(sx, sz)
-    if C[THETA, k, i] < dense:
-        out = bed.held(fluid_u, width, 2.0 * radius, rho_p, rho_f, mu, gravity, wall_law)
-    return out
-
-
-@ti.func
 def row(s: ti.template(), j: ti.template()):
     """Row j of a (SEEN, LANES) matrix as a LANES vector."""
     return ti.Vector([s[j, l] for l in ti.static(range(LANES))], dt=ti.f64)
@@ -358,10 +345,11 @@ def move(p: ti.i32, sx: ti.f64, sz: ti.f64, flag: ti.i32, P: ti.template(), dt: 
 def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(), C: ti.template(),
                 FLAGS: ti.template(), dt: ti.f64, PR: ti.template()):
     """After the drag solve of parcel p: on a bed (on_bed), the slope's push (with bed_slope, in a dense cell or
-    below the threshold of motion, closures.bed.slope_acceleration; both it and the friction then over the
-    drag's denominator only, particle_ops_numpy.push and slope), bed friction (a_f the larger of the own weight's and the own cell's
-    BED_STRENGTH, particle_ops_numpy.bed_friction) and the threshold of motion on a bed surface (deposited, with
-    shields_deposition, unless the slope's push exceeds a_f); bridging, the move, and the lags 1 - r of the
+    on a bed surface below the threshold of motion, closures.bed.slope_acceleration; both it and the friction
+    then over the drag's denominator only, particle_ops_numpy.push), bed friction (a_f the larger of the own
+    weight's and the own cell's BED_STRENGTH, particle_ops_numpy.bed_friction) and the threshold of motion on a
+    bed surface (closures.bed.held once per parcel, particle_ops_numpy._on_surface: with shields_deposition a
+    held grain stops, unless the slope's push exceeds a_f); bridging, the move, and the lags 1 - r of the
     implicit drag (simulator.parcel_response)."""
     sx, sz = cell_coordinates(P, p, PR)
     flag = owner_flags(sx, sz, FLAGS)
@@ -374,20 +362,21 @@ def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(),
             k, i = owner(sx, sz)
             friction = ti.max(PR[P_BED_FRICTION] * ti.abs((1.0 - rho_f / P[DENSITY, p]) * gravity),
                               C[BED_STRENGTH, k, i])
+            surface = C[THETA, k, i] < dense
+            held = 0
+            if surface:
+                if PR[P_SHIELDS] > 0.0 or PR[P_BED_SLOPE] > 0.0:
+                    held = bed.held(W[S_UF, p], W[S_WIDTH, p], 2.0 * P[RADIUS, p], P[DENSITY, p], rho_f, PR[P_MU],
+                                    gravity, ti.cast(PR[P_WALL_LAW], ti.i32))
             slope = 0.0
             if PR[P_BED_SLOPE] > 0.0:
-                resting = 1
-                if C[THETA, k, i] < dense:
-                    resting = bed.held(W[S_UF, p], W[S_WIDTH, p], 2.0 * P[RADIUS, p], P[DENSITY, p], rho_f, PR[P_MU],
-                                       gravity, ti.cast(PR[P_WALL_LAW], ti.i32))
-                if resting:
+                if not surface or held:
                     slope = bed.slope_acceleration(sx, sz, P[DENSITY, p], C, PR[P_THETA_CP], PR[P_DX])
                 den = 1.0 + dt * W[DRAG, p]
                 P[U, p] += dt * slope / den
             P[U, p] = bed.bed_friction(P[U, p], friction, dt, den)
-            if PR[P_SHIELDS] > 0.0 and ti.abs(slope) <= friction:
-                if deposited(sx, sz, W[S_UF, p], W[S_WIDTH, p], P[RADIUS, p], P[DENSITY, p], C, dense, rho_f,
-                             PR[P_MU], gravity, ti.cast(PR[P_WALL_LAW], ti.i32)):
+            if PR[P_SHIELDS] > 0.0 and held:
+                if ti.abs(slope) <= friction:
                     P[U, p] = 0.0
     S[STATE, p] = SUSPENDED
     if W[S_WIDTH, p] < PR[P_BRIDGING] * 2.0 * P[RADIUS, p]:

@@ -75,7 +75,7 @@ class MppicParams:
     "dean" = Eq. 9 times max(1, (0.073/12) Re^(3/4)), Re = rho_f |u| w / mu_f, Dean's (1978) turbulent skin
     friction of smooth plane-channel flow, c_f = 0.073 Re^(-1/4), past the crossing of the two laws at
     Re = 899 (identical to "laminar" below it; hfgpu.proppant.momentum).
-    shields_deposition: threshold of motion on the bed surface (push, particle_ops_numpy._deposited): a
+    shields_deposition: threshold of motion on the bed surface (push, particle_ops_numpy._on_surface): a
     parcel resting on a bed surface (on a floor, or above a dense cell, its own cell loose; on_bed) stops along
     the bed (x velocity 0) while the Shields number of the bed shear stress of the fluid it sees is below the
     critical one: tau_b / ((rho_p - rho_f) g d) < theta_cr (Shields 1936; theta_cr of Soulsby & Whitehouse

@@ -53,9 +53,9 @@ class GridFields:
     interpolation.velocity_nodes), fluid velocities and gradients at faces, the cell
     fields theta_p, mean parcel velocity, damping rate and width (the push reads theta_p and width for its
     walls and packing cap), bed_strength, the bed friction per unit mass of the overburden a_f [m/s^2], and
-    the loads W_top, W_own [Pa] of the bed's slope (hfgpu.kernels.closures.bed; zeros without bed_slope), and what the averaging (its name, ``averaging``) reads: the moments' S, S_x,
-    S_z and the cell volume dx dz w (hfgpu.kernels.closures.averaging). Built once per particle step by
-    ``grid_fields``."""
+    the loads W_top, W_own [Pa] of the bed's slope (hfgpu.kernels.closures.bed; zeros without bed_slope), and
+    what the averaging (its name, ``averaging``) reads: the moments' S, S_x, S_z and the cell volume dx dz w
+    (hfgpu.kernels.closures.averaging). Built once per particle step by ``grid_fields``."""
 
     cell_mask: np.ndarray
     xface_mask: np.ndarray
@@ -218,24 +218,16 @@ def bed_load(frame: GridFrame, width: np.ndarray, moments: CellMoments, params: 
     return {"load_top": top, "load_own": own}
 
 
-def slope(parcels: Parcels, resting: np.ndarray, seen: ParcelFluid, frame: GridFrame, fields: GridFields,
-          params: MppicParams, fluid_density: float, fluid_viscosity: float, gravity: float) -> np.ndarray:
+def slope(parcels: Parcels, pushed: np.ndarray, frame: GridFrame, fields: GridFields,
+          params: MppicParams) -> np.ndarray:
     """The slope's push a_s per unit mass [m/s^2] (closures.bed, slope_acceleration_numpy) of the parcels
-    ``resting`` on a bed that lie in a dense cell or, on a bed surface (own cell loose), are below the threshold
-    of motion of the flow they see (closures.bed.held_numpy, whatever shields_deposition: a grain the flow
-    entrains is carried by it, not resting on the slope); 0 for the others and without bed_slope."""
+    ``pushed`` (push: those on a bed in a dense cell, or on a bed surface and below the threshold of motion), 0
+    for the others and without bed_slope."""
     out = np.zeros(parcels.n)
-    if not params.bed_slope:
-        return out
-    k, i, _ = owning_cell(parcels.x, parcels.z, frame, fields.width.shape)
-    with np.errstate(divide="ignore", invalid="ignore"):  # a neutrally buoyant grain: never held
-        held = bed.held_numpy(seen.fluid_u, np.where(resting, seen.width, 1.0), 2.0 * parcels.radius,
-                              parcels.density, fluid_density, fluid_viscosity, gravity, params.wall_friction_code)
-    resting = resting & ((fields.volume_fraction[k, i] >= params.friction_volume_fraction) | held)
-    if resting.any():
-        out[resting] = bed.slope_acceleration_numpy(
-            (parcels.x[resting] - frame.x0) / frame.dx, (parcels.z[resting] - frame.z0) / frame.dz,
-            parcels.density[resting], fields.load_top, fields.load_own, fields.volume_fraction, fields.width,
+    if params.bed_slope and pushed.any():
+        out[pushed] = bed.slope_acceleration_numpy(
+            (parcels.x[pushed] - frame.x0) / frame.dx, (parcels.z[pushed] - frame.z0) / frame.dz,
+            parcels.density[pushed], fields.load_top, fields.load_own, fields.volume_fraction, fields.width,
             params.theta_cp, frame.dx)
     return out
 
@@ -305,20 +297,22 @@ def on_bed(x, z, radius, frame: GridFrame, width: np.ndarray, volume_fraction: n
     return inside & (dense | on_floor)
 
 
-def _deposited(x, z, on_bed, seen: ParcelFluid, radius, rho_p, frame: GridFrame, fields: GridFields,
-               params: MppicParams, fluid_density, fluid_viscosity, gravity) -> np.ndarray:
-    """True where a parcel rests on a bed surface below the threshold of motion (shields_deposition): on a
-    bed (on_bed) with its own cell loose (theta_p < friction_volume_fraction: a grain on the floor or on top
-    of a dense cell, not inside the bed) and a Shields number of the bed shear stress of the fluid velocity
-    along the bed it sees below the critical one, tau_b / ((rho_p - rho_f) g 2r) < theta_cr
-    (hfgpu.kernels.closures.bed.held_numpy)."""
-    if not params.shields_deposition:
-        return np.zeros(x.shape, dtype=bool)
-    k, i, _ = owning_cell(x, z, frame, fields.width.shape)
+def _on_surface(parcels: Parcels, on_bed: np.ndarray, seen: ParcelFluid, frame: GridFrame, fields: GridFields,
+                params: MppicParams, fluid_density, fluid_viscosity, gravity) -> tuple[np.ndarray, np.ndarray]:
+    """(surface, held): the parcels on a bed (on_bed) whose own cell is loose (theta_p <
+    friction_volume_fraction: a grain on the floor or on top of a dense cell, not inside the bed), and those of
+    them below the threshold of motion of the fluid velocity along the bed they see, a Shields number
+    tau_b / ((rho_p - rho_f) g 2r) < theta_cr (hfgpu.kernels.closures.bed.held_numpy; evaluated only where
+    shields_deposition or bed_slope reads it, else none held)."""
+    k, i, _ = owning_cell(parcels.x, parcels.z, frame, fields.width.shape)
     surface = on_bed & (fields.volume_fraction[k, i] < params.friction_volume_fraction)
+    if not (params.shields_deposition or params.bed_slope):
+        return surface, np.zeros(parcels.n, dtype=bool)
     width = np.where(surface, seen.width, 1.0)
-    return surface & bed.held_numpy(seen.fluid_u, width, 2.0 * radius, rho_p, fluid_density, fluid_viscosity,
-                                    gravity, params.wall_friction_code)
+    with np.errstate(divide="ignore", invalid="ignore"):  # a neutrally buoyant grain: never held
+        held = bed.held_numpy(seen.fluid_u, width, 2.0 * parcels.radius, parcels.density, fluid_density,
+                              fluid_viscosity, gravity, params.wall_friction_code)
+    return surface, surface & held
 
 
 def bed_friction(parcels: Parcels, frame: GridFrame, fields: GridFields, buoyant_g: np.ndarray,
@@ -354,8 +348,9 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     before the walls, each as dt a / den; with bed_slope over the drag's 1 + dt D only: these contact forces
     act on the skeleton, whose mean velocity the collision damping (which relaxes a grain towards its
     cell's mean) must not hold back (at theta_p >= theta_cp its rate reaches 1e5-1e6 1/s, which froze a
-    packed cliff); with shields_deposition, one on a bed surface below the threshold of motion
-    (_deposited) stops along x unless |a_s| exceeds its friction (an avalanche).
+    packed cliff). The slope pushes a grain in a dense cell, and one on a bed surface only below the threshold
+    of motion (_on_surface: a grain the flow entrains is carried by it); with shields_deposition, one on a bed
+    surface below the threshold of motion stops along x unless |a_s| exceeds its friction (an avalanche).
     Bridging: where the width of the parcel's cell is below bridging_factor x 2 r the parcel is set to state 1
     with zero velocity and does not move; others get state 0. Gravity [m/s^2] acts along +z (depth).
     """
@@ -378,13 +373,14 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
                                           params.packing_restitution)
     resting = on_bed(parcels.x, parcels.z, parcels.radius, frame, fields.width, fields.volume_fraction, params)
     friction = bed_friction(parcels, frame, fields, buoyant_g, params)
-    push_down = slope(parcels, resting, seen, frame, fields, params, fluid_density, fluid_viscosity, gravity)
+    surface, held = _on_surface(parcels, resting, seen, frame, fields, params, fluid_density, fluid_viscosity,
+                                gravity)
+    push_down = slope(parcels, resting & (~surface | held), frame, fields, params)
     contact = 1.0 + dt * drag if params.bed_slope else den
     u_new = np.where(resting, u_new + dt * push_down / contact, u_new)
     u_new = bed.bed_friction_numpy(u_new, resting, friction, dt, contact)
-    u_new = np.where(_deposited(parcels.x, parcels.z, resting, seen, parcels.radius, rho_p, frame, fields, params,
-                                fluid_density, fluid_viscosity, gravity) & (np.abs(push_down) <= friction),
-                     0.0, u_new)
+    deposited = held & (np.abs(push_down) <= friction) if params.shields_deposition else np.zeros(parcels.n, bool)
+    u_new = np.where(deposited, 0.0, u_new)
     bridged = seen.width < params.bridging_factor * 2.0 * parcels.radius
     u_new = np.where(bridged, 0.0, u_new)
     v_new = np.where(bridged, 0.0, v_new)

@@ -86,9 +86,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from hfgpu.kernels.closures.twin import ti
+from hfgpu.kernels.closures.twin import Deferred, ti
 from hfgpu.kernels.closures.wall_friction import wall_friction_factor, wall_friction_factor_numpy
 from hfgpu.kernels.layout import BED_STRENGTH, LOAD_OWN, LOAD_TOP, M_MASS, M_VOLUME, THETA, WIDTH
+
+stencil = Deferred("hfgpu.kernels.stencil")
 
 #: what presses a resting grain onto the bed (module docstring); the kernels' code is the index
 BED_STRESSES = ("grain", "overburden")
@@ -218,8 +220,6 @@ def column_load(cells: ti.template(), i: ti.i32, dense: ti.f64, dx: ti.f64, flui
             top = above
             own = (mass - fluid_density * cells[M_VOLUME, k, i]) * gravity / (dx * width)
             above = above + own
-        else:
-            above = 0.0
         cells[LOAD_TOP, k, i] = top
         cells[LOAD_OWN, k, i] = own
 
@@ -248,15 +248,6 @@ def load_at(cells: ti.template(), k: ti.i32, col: ti.i32, zeta: ti.f64, theta_cp
 
 
 @ti.func
-def open_cell(cells: ti.template(), k: ti.i32, col: ti.i32) -> ti.i32:
-    """Cell (k, col) is inside the grid and open."""
-    out = 0
-    if col >= 0 and col < cells.shape[2]:
-        out = ti.cast(cells[WIDTH, k, col] > 0.0, ti.i32)
-    return out
-
-
-@ti.func
 def slope_acceleration(sx: ti.f64, sz: ti.f64, density: ti.f64, cells: ti.template(), theta_cp: ti.f64,
                        dx: ti.f64) -> ti.f64:
     """a_s of a parcel at cell coordinates (sx, sz) inside the grid (slope_acceleration_numpy), from the
@@ -267,9 +258,9 @@ def slope_acceleration(sx: ti.f64, sz: ti.f64, density: ti.f64, cells: ti.templa
     zeta = sz - k + 0.5
     here = load_at(cells, k, i, zeta, theta_cp)
     gradient = 0.0
-    if open_cell(cells, k, i - 1):
+    if not stencil.closed(k, i - 1, cells):
         gradient += (1.0 - xi) * (here - load_at(cells, k, i - 1, zeta, theta_cp))
-    if open_cell(cells, k, i + 1):
+    if not stencil.closed(k, i + 1, cells):
         gradient += xi * (load_at(cells, k, i + 1, zeta, theta_cp) - here)
     return -gradient / dx / (theta_cp * density)
 

@@ -17,6 +17,9 @@ Measured (NumPy backend, seed 0; by owning row k, the bed rows k = 4 (top) .. 7)
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -27,51 +30,17 @@ from hfgpu.proppant.parcels import Parcels
 from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+from bed_validation import load_scene_text  # noqa: E402
+
 L, H, W, DZ, ROWS = 0.10, 0.04, 5e-3, 5e-3, 4
 RHO_P, RADIUS, THETA = 2650.0, 0.15e-3, 0.58
 TOP = int(H / DZ) - ROWS  # the bed's top row
 
 
 def scene(speed: float, bed_stress: str, end: float) -> str:
-    clear = H - ROWS * DZ
-    return f"""
-[run]
-end_time = "{end} s"
-physics = ["proppant"]
-seed = 1
-[fluid]
-viscosity = "1 cP"
-[mesh]
-cell_size = "{DZ} m"
-[output]
-every = "1 s"
-[geometry]
-kind = "slot"
-length = "{L} m"
-height = "{H} m"
-width = "{W} m"
-[[geometry.inlets]]
-kind = "segment"
-x = "1 mm"
-depth = "1 mm"
-x_end = "1 mm"
-depth_end = "{clear - 1e-3} m"
-[[geometry.outlets]]
-kind = "segment"
-x = "{L - 1e-3} m"
-depth = "1 mm"
-x_end = "{L - 1e-3} m"
-depth_end = "{clear - 1e-3} m"
-[injection]
-schedule = [{{ until = "100 s", rate = "{speed * clear * W} m**3/s" }}]
-[[proppant]]
-name = "sand"
-density = "{RHO_P} kg/m**3"
-diameter = "{2 * RADIUS} m"
-[mppic]
-backend = "numpy"
-bed_stress = "{bed_stress}"
-"""
+    """The slot of bench/bed_validation.py's bed-load set-up, L long, in 1 cP water, with ``bed_stress``."""
+    return load_scene_text(speed, end, f'bed_stress = "{bed_stress}"', length=L, viscosity=1e-3)
 
 
 def run_bed(speed: float, bed_stress: str, end: float) -> ProppantSimulation:
