@@ -5,8 +5,6 @@ and their sources."""
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..kernels.closures import damping, drag
 from ..kernels.closures import slurry_viscosity as viscosity
 from ..kernels.closures import particle_stress as stress
