@@ -30,8 +30,9 @@ import numpy as np
 from field_case import load, propped_area_panel, report, save  # demos/ is on sys.path when run as a script
 
 from hfgpu import open_results, run
+from hfgpu.kernels.stencil_numpy import owning_cell
 from hfgpu.propped import (GROUPS, PACKED_SPEED, created_area, packed_fraction, packed_history, parcel_groups,
-                           propped_cells)
+                           propped_cells, results_times)
 from hfgpu.reference.settling import column_settling_velocity
 from hfgpu.scene_text import assignment
 from hfgpu.units import to_si
@@ -75,6 +76,23 @@ def settling_bound(results) -> float:
                                            phi))
     start, end = float(snaps.times[0]), float(snaps.times[-1])
     return float(np.clip((end - fall / speed - start) / (end - start), 0.0, 1.0))
+
+
+def narrowest_held(results) -> list[tuple[float, float]]:
+    """(snapshot time, w / d) at the paper's Fig. 16 times (hfgpu.propped.results_times): the narrowest width of
+    the cells that hold parcels over the class's mean grain diameter. A parcel bridges where w / d falls below
+    ``bridging_factor`` (2): above it, no parcel stands where it could be trapped (the paper's Fig. 15)."""
+    scene = results.scene
+    diameter = scene.proppant.classes[0].size.mean
+    out = []
+    for t in results_times(results):
+        snap = results.proppant_snapshots.at(t)
+        width = np.asarray(snap.grid["width"])
+        k, i, inside = owning_cell(snap.parcels["x"], snap.parcels["z"], snap.frame, width.shape)
+        held = width[k[inside], i[inside]]
+        held = held[held > 0.0]
+        out.append((snap.time, float(held.min()) / diameter if held.size else float("nan")))
+    return out
 
 
 def result_path(out: Path, size: str) -> Path:
@@ -128,7 +146,8 @@ def main() -> None:
         groups = parcel_groups(results.proppant_snapshots[-1], scene.proppant, scene.fluid.density,
                                scene.fluid.viscosity)
         rows.append((size, {**report(path), "held_back": held, "closed": closed, "groups": next(iter(groups.values())),
-                            "definitions": definitions(results)}, status))
+                            "definitions": definitions(results), "narrowest": narrowest_held(results),
+                            "bridging": scene.proppant.params.bridging_factor}, status))
     times = "/".join(f"{t:.0f}" for t, _ in rows[0][1]["packed"])
     print(f"{'size':>8} {'t end s':>8} {'created m^2':>12} {'propped m^2':>12} {'propped %':>10} "
           f"{'packed at ' + times + ' s':>24} "
@@ -159,6 +178,10 @@ def main() -> None:
         print(f"{size:>8} packed {' / '.join(f'{p:.2f}' for p in d['packed'])}  in a bed {d['bed']:.2f}  "
               f"can have settled {d['settled']:.2f}  "
               f"propped {' / '.join(f'{100 * p:.1f}' for p in d['propped'])} %")
+    print(f"\nnarrowest width holding parcels, in mean grain diameters, at {times} s (bridging below "
+          f"bridging_factor, {rows[0][1]['bridging']:g})")
+    for size, r, _ in rows:
+        print(f"{size:>8} " + " / ".join(f"{ratio:.1f}" for _, ratio in r["narrowest"]))
     base = rows[0][1]["propped_area"]
     for size, r, _ in rows[1:]:
         if base > 0:
