@@ -43,6 +43,7 @@ JET_DIRECTIONS = ("none", "+x", "-x", "+z", "-z")
 BACKENDS = ("taichi", "numpy")
 #: Placements of the initial suspension's parcels in their cells (hfgpu.proppant.injection.initial_suspension).
 PLACEMENTS = ("lattice", "stratified")
+GRAIN_PRESSURES = ("last", "two-step")
 
 
 @dataclass(frozen=True)
@@ -116,6 +117,9 @@ class MppicNumerics:
     gravity [m/s^2] acts along +depth.
     initial_placement: where the initial suspension's parcels sit in their cells, "lattice" (a quiet start:
     theta_p starts without sampling noise) or "stratified" (random; hfgpu.proppant.injection.initial_suspension).
+    grain_pressure: the fluid pressure the parcels take during a fluid step (simulator.ProppantSimulation.step):
+    "last" = that of the fluid step before, "two-step" = the mean of the two fluid steps before, which cancels a
+    pressure that changes sign from one step to the next (docs/proppant-closures.md, "Pressure the grains take").
     slurry_viscosity: the fluid phase uses the slurry viscosity of Eq. 10 (MppicParams.viscosity_law); false
     uses the clean-fluid viscosity. Eq. 10 diverges at close packing; the momentum predictor takes the
     in-plane diffusion and wall friction implicitly and MppicParams.max_relative_viscosity caps mu_f / mu_0,
@@ -139,6 +143,7 @@ class MppicNumerics:
     gravity: float = 9.81
     slurry_viscosity: bool = True
     initial_placement: str = "lattice"
+    grain_pressure: str = "last"
 
 
 @dataclass(frozen=True)
@@ -337,6 +342,7 @@ def _parse_mppic(t: Table, preset: Preset = BALANCED) -> tuple[MppicNumerics, An
         gravity=t.quantity("gravity", "acceleration", d.gravity, minimum=0.0),
         slurry_viscosity=t.boolean("slurry_viscosity", d.slurry_viscosity),
         initial_placement=t.choice("initial_placement", PLACEMENTS, d.initial_placement),
+        grain_pressure=t.choice("grain_pressure", GRAIN_PRESSURES, d.grain_pressure),
     )
     params = _parse_params(t)
     t.finish()

@@ -209,6 +209,7 @@ class ProppantSimulation:
                                   params=self.params if n.slurry_viscosity else None,
                                   wall_friction=self.params.wall_friction, arch=self.engine.arch)
         self.fluid = self.solver.initial_state(self._fluid_theta_p())
+        self.previous_pressure = self.fluid.p.copy()   # the pressure of the fluid step before the last
         self.steps = 0
         self.safety = 1.0
         self.limited_by = "dt_max"
@@ -295,7 +296,7 @@ class ProppantSimulation:
                 self.engine.set_grid(self.grid)
             if not (dt > 0.0 and t0 + dt > t0):
                 raise SimulationError(f"zero-length time step (dt = {dt:g} s)", time=t0)
-            self.engine.begin_step(self.fluid.u, self.fluid.v, self.fluid.p)
+            self.engine.begin_step(self.fluid.u, self.fluid.v, self.grain_pressure())
             if self.injector is not None:
                 self._inject(t0, t0 + dt)
             t_a = perf_counter()
@@ -327,6 +328,7 @@ class ProppantSimulation:
                                   f"({KEYS['fluid Courant']}); {where}", time=t0)
         self.engine.commit()
         self.outflow += loop.outflow
+        self.previous_pressure = self.fluid.p
         self.fluid = trial
         for name in FLUID_VOLUMES:
             self.fluid_totals[name] += getattr(info, name)
@@ -344,6 +346,15 @@ class ProppantSimulation:
         return StepInfo(time=self.time, dt=dt, simple_iterations=info.iterations,
                         continuity_residual=info.continuity_residual, courant=info.courant,
                         parcels=self.engine.live, retries=retry)
+
+    def grain_pressure(self) -> np.ndarray:
+        """The pressure the parcels take in the next step ([mppic] grain_pressure): the last fluid step's, or
+        with "two-step" the mean of the last two, (p^n + p^(n-1)) / 2. Each step the parcels move with the
+        pressure of the step before and the fluid then answers the volume they moved; where it answers with a
+        pressure of the opposite sign (dense cells, docs/proppant-closures.md) the mean cancels that mode."""
+        if self.numerics.grain_pressure == "two-step":
+            return 0.5 * (self.fluid.p + self.previous_pressure)
+        return self.fluid.p
 
     def _inject(self, t0: float, t1: float) -> None:
         """Add the inlets' parcels for (t0, t1] into the room left below close packing, theta_cp V_cell minus
@@ -461,13 +472,15 @@ class ProppantSimulation:
 
     def state(self) -> dict:
         """Everything needed to continue from now (a checkpoint): STATE_ATTRIBUTES, the fluid volumes, the parcels,
-        the fluid fields, the width and leak-off the grid holds, the pressure solver's reused LU factors (as the
-        matrix factorised), the random generator's state (numpy ``bit_generator.state``, as JSON), the unphysical
-        states already reported (hfgpu.proppant.health, as JSON) and the inlets' owed volumes and next diameters."""
+        the fluid fields and the pressure of the step before (grain_pressure), the width and leak-off the grid
+        holds, the pressure solver's reused LU factors (as the matrix factorised), the random generator's state
+        (numpy ``bit_generator.state``, as JSON), the unphysical states already reported (hfgpu.proppant.health, as
+        JSON) and the inlets' owed volumes and next diameters."""
         rng = self.injector.rng if self.injector is not None else self.rng  # a step retry deep-copies it
         state = {**{name: getattr(self, name) for name in self.STATE_ATTRIBUTES},
                  "fluid_totals": dict(self.fluid_totals), "parcels": self.parcels.as_dict(),
                  "fluid": {f.name: getattr(self.fluid, f.name).copy() for f in dataclasses.fields(self.fluid)},
+                 "previous_pressure": self.previous_pressure.copy(),
                  "width": np.array(self.grid.width), "leakoff": self.leakoff.copy(),
                  "linear": self.solver.linear.state(), "rng": json.dumps(rng.bit_generator.state),
                  "watch": json.dumps(self.watch.found)}
@@ -490,6 +503,8 @@ class ProppantSimulation:
         self.engine.set_parcels(Parcels(**{name: np.array(a) for name, a in state["parcels"].items()}))
         self.solver.linear.restore(state["linear"])
         self.fluid = FluidState(**{name: np.array(a) for name, a in state["fluid"].items()})
+        self.previous_pressure = np.array(state["previous_pressure"]) if "previous_pressure" in state \
+            else self.fluid.p.copy()
         self.rng.bit_generator.state = json.loads(state["rng"])
         self.watch.found = json.loads(state["watch"]) if "watch" in state else {}
         if self.injector is not None:

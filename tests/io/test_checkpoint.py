@@ -382,11 +382,14 @@ def test_fracture_engine_state_round_trip(tmp_path):
     assert np.array_equal(engine.grid["w"], other.grid["w"]) and engine.balance() == other.balance()
 
 
-def test_proppant_simulation_state_round_trip(tmp_path):
+@pytest.mark.parametrize("grain_pressure", ["last", "two-step"])
+def test_proppant_simulation_state_round_trip(grain_pressure, tmp_path):
+    """The restored simulation steps as the one it came from (with "two-step", the pressure of the step before
+    travels in the state)."""
     from hfgpu.proppant.engine_setup import proppant_engine_setup
     from hfgpu.proppant.simulator import ProppantSimulation
 
-    scene = load_scene(PROPPANT)
+    scene = load_scene(PROPPANT + f'grain_pressure = "{grain_pressure}"\n')
     sim = ProppantSimulation(proppant_engine_setup(scene))
     for _ in range(8):
         sim.step(limit=0.3 - sim.time)

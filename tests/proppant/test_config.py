@@ -142,3 +142,13 @@ def test_field_geometry_from_npz(tmp_path):
         load_scene(text.replace('cell_size = "1 cm"', 'cell_size = "2 cm"'))
     with pytest.raises(SceneError, match="no such width file"):
         load_scene(text.replace("w.npz", "missing.npz"))
+
+
+def test_grain_pressure_key():
+    """[mppic] grain_pressure: default "last", "two-step" accepted, another value refused in one line naming the
+    key, the value and the allowed ones."""
+    assert load_scene(BOX).proppant.numerics.grain_pressure == "last"
+    assert load_scene(BOX + 'grain_pressure = "two-step"\n').proppant.numerics.grain_pressure == "two-step"
+    with pytest.raises(SceneError) as err:
+        load_scene(BOX + 'grain_pressure = "mean"\n')
+    assert "mppic.grain_pressure" in str(err.value) and "'mean'" in str(err.value) and "two-step" in str(err.value)
