@@ -94,7 +94,7 @@ PARAMS = ("x0", "z0", "dx", "dz", "theta_cp", "epsilon", "packing_restitution", 
           "drag_re_coefficient", "bridging_factor", "drag_iterations", "bed_friction", "bed_stress_code",
           "bed_slope", "friction_volume_fraction",
           "shields_deposition", "wall_friction_code", "rho_f", "mu_f", "gravity", "P_s", "beta", "restitution",
-          "damping", "damping_threshold", "averaging_code")
+          "damping", "damping_threshold", "damping_scheme_code", "averaging_code")
 P_X0 = PARAMS.index("x0")
 P_Z0 = PARAMS.index("z0")
 P_DX = PARAMS.index("dx")
@@ -120,6 +120,7 @@ P_STRESS_BETA = PARAMS.index("beta")
 P_RESTITUTION = PARAMS.index("restitution")
 P_DAMPING = PARAMS.index("damping")
 P_DAMPING_THRESHOLD = PARAMS.index("damping_threshold")
+P_DAMPING_SCHEME = PARAMS.index("damping_scheme_code")
 P_AVERAGING = PARAMS.index("averaging_code")
 PARAM_COUNT = len(PARAMS)
 # sub-loop reports (ST)

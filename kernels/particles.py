@@ -34,7 +34,7 @@ from hfgpu.kernels.layout import (
     BRIDGED, CELL, DAMPING, DENSITY, DRAG, F_DP, F_DTAU, F_MASK, F_VELOCITY, F_WALLS, GONE, LAG_X, LAG_Z, MEAN_U,
     F_WIDTH, MEAN_V, OUTLET, P_BED_FRICTION, P_BRIDGING, P_DAMPING_THRESHOLD, P_DRAG_ITERATIONS, P_DRAG_LAW, P_DX, P_DZ,
     P_AVERAGING, P_EPSILON, P_FRICTION_FRACTION, P_GRAVITY, P_MU, P_PACKING_RESTITUTION, P_RE_COEFFICIENT, P_RHO_F,
-    P_BED_SLOPE, P_SHIELDS,
+    P_BED_SLOPE, P_DAMPING_SCHEME, P_SHIELDS,
     P_THETA_CP, P_WALL_LAW, P_X0, P_Z0, PARTICLES, RADIUS, S_DAMPING, S_DPDX, S_DPDZ, S_DTDX, S_DTDZ, S_MEAN_U,
     S_MEAN_V, S_THETA, S_UF, S_VF, S_WIDTH, SEEN, ST_BAD_PARCEL, ST_BAD_STEP, ST_LEFT, ST_OUTFLOW, ST_SPEED,
     ST_VOLUME, STATE, SUSPENDED, THETA, U, V, WIDTH, X, Z)
@@ -291,10 +291,19 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, P: ti.template(), s: ti.template(), dt
     force_u = u0 + dt * (half_rate * mean_u - dpdx * inv_rho)
     force_v = v0 + dt * (half_rate * mean_v + buoyant_g - dpdz * inv_rho)
     den_rest = 1.0 + dt * half_rate
+    push_u = -dt * dpdx * inv_rho
+    push_v = dt * (buoyant_g - dpdz * inv_rho)
+    relaxation = PR[P_DAMPING_SCHEME] > 0.0
+    if relaxation:  # closures.damping.DAMPING_SCHEMES, particle_ops_numpy._relaxation_velocity
+        keep = dt * half_rate / (1.0 + dt * half_rate)
+        force_u = u0 + keep * (mean_u - u0) + push_u
+        force_v = v0 + keep * (mean_v - v0) + push_v
+        den_rest = half_rate * 0.0 + 1.0
     un = u0
     vn = v0
     rate = u0 * 0.0
     inv_den = rate + 1.0
+    dt_drag = rate
     for _ in range(ti.cast(PR[P_DRAG_ITERATIONS], ti.i32)):
         re = re_per_slip * ti.sqrt((uf - un) ** 2 + (vf - vn) ** 2)
         rate = drag.drag_rate(re, stokes_hinder, snider, law, re_coefficient)
@@ -302,12 +311,17 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, P: ti.template(), s: ti.template(), dt
         inv_den = 1.0 / (den_rest + dt_drag)
         un = (force_u + dt_drag * uf) * inv_den
         vn = (force_v + dt_drag * vf) * inv_den
+    bound_u = mean_u
+    bound_v = mean_v
+    if relaxation:  # the mean moved by the same step
+        bound_u = (mean_u + push_u + dt_drag * uf) * inv_den
+        bound_v = (mean_v + push_v + dt_drag * vf) * inv_den
     scale = -dt * inv_den * inv_rho / ti.max(theta, PR[P_EPSILON])
     gx = row(s, S_DTDX)
     gz = row(s, S_DTDZ)
     restitution = PR[P_PACKING_RESTITUTION]
-    un = un + particle_stress.packing_limiter(scale * gx, mean_u - un, gx, restitution)
-    vn = vn + particle_stress.packing_limiter(scale * gz, mean_v - vn, gz, restitution)
+    un = un + particle_stress.packing_limiter(scale * gx, bound_u - un, gx, restitution)
+    vn = vn + particle_stress.packing_limiter(scale * gz, bound_v - vn, gz, restitution)
     return un, vn, rate
 
 
@@ -359,6 +373,8 @@ def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(),
     if not flag & LOOSE:
         if on_bed(sx, sz, P[RADIUS, p], PR[P_DZ], C, dense) > 0.0:
             den = 1.0 + dt * (W[DRAG, p] + 0.5 * W[S_DAMPING, p])
+            if PR[P_DAMPING_SCHEME] > 0.0:
+                den = 1.0 + dt * W[DRAG, p]
             k, i = owner(sx, sz)
             friction = ti.max(PR[P_BED_FRICTION] * ti.abs((1.0 - rho_f / P[DENSITY, p]) * gravity),
                               C[BED_STRENGTH, k, i])

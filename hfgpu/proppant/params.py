@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from ..errors import SceneError
 from ..kernels.closures.averaging import AVERAGINGS
+from ..kernels.closures.damping import DAMPING_SCHEMES
 from ..kernels.closures.bed import BED_STRESSES
 from ..kernels.closures.drag import DRAG_LAWS
 from ..kernels.closures.slurry_viscosity import VISCOSITY_LAWS
@@ -41,6 +42,9 @@ class MppicParams:
     driven into a denser region faster than the mean parcel velocity is sent back at most e times its
     relative velocity. Default 0 (inelastic): a bed whose stress carries its weight is then exactly at rest.
     damping: collision damping on/off; active only where theta_p > damping_threshold x theta_cp.
+    damping_scheme: how the push applies it (hfgpu.kernels.closures.damping.DAMPING_SCHEMES): "implicit"
+    (O'Rourke & Snider 2010, inside the drag's denominator) or "relaxation" (the old velocity relaxed towards
+    the cell's mean, then the drag step: the cell's mean answers drag and gravity as without damping).
     bed_friction: Coulomb friction coefficient mu_b of a parcel resting in or on a dense bed (push,
     hfgpu.kernels.closures.bed): its velocity along the bed (x, normal to gravity) loses at most
     dt mu_b |1 - rho_f/rho_p| g per step (the friction its own submerged weight can mobilise), so a resting grain
@@ -98,6 +102,7 @@ class MppicParams:
     drag_iterations: int = 3
     packing_restitution: float = 0.0
     damping: bool = True
+    damping_scheme: str = "implicit"
     damping_threshold: float = 0.5
     bed_friction: float = 0.543
     bed_stress: str = "grain"
@@ -130,6 +135,8 @@ class MppicParams:
             raise bad("bed_stress", f"allowed: one of {list(BED_STRESSES)}")
         if self.averaging not in AVERAGINGS:
             raise bad("averaging", f"allowed: one of {list(AVERAGINGS)}")
+        if self.damping_scheme not in DAMPING_SCHEMES:
+            raise bad("damping_scheme", f"allowed: one of {list(DAMPING_SCHEMES)}")
         if self.wall_friction not in WALL_FRICTION_LAWS:
             raise bad("wall_friction", f"allowed: one of {list(WALL_FRICTION_LAWS)}")
         if not self.viscosity_exponent < 0.0:
@@ -161,6 +168,11 @@ class MppicParams:
     def averaging_code(self) -> int:
         """Integer code of the averaging for kernels: 0 dual, 1 basic, 2 moment (closures.averaging.AVERAGINGS)."""
         return AVERAGINGS.index(self.averaging)
+
+    @property
+    def damping_scheme_code(self) -> int:
+        """Integer code of the damping scheme for kernels: 0 implicit, 1 relaxation (closures.damping.DAMPING_SCHEMES)."""
+        return DAMPING_SCHEMES.index(self.damping_scheme)
 
     @property
     def wall_friction_code(self) -> int:

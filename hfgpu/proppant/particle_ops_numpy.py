@@ -330,9 +330,9 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
 
     Velocity: u~ = (u^o + dt (D u_f - grad p / rho_p + (1 - rho_f/rho_p) g + <u>/(2 tau_D))) /
     (1 + dt (D + 1/(2 tau_D))), drag D(|u_f - u|) iterated ``drag_iterations`` times starting from u^o (the
-    returned D is the one of the last solve). Then the stress term -dt grad tau / (theta_p rho_p (1 + ...)),
-    limited per component by Snider (2001) eqs. 39-41 (packing limiter,
-    hfgpu.kernels.closures.particle_stress).
+    returned D is the one of the last solve); with damping_scheme "relaxation" the damping acts first instead
+    (:func:`_relaxation_velocity`). Then the stress term -dt grad tau / (theta_p rho_p (1 + ...)), limited per
+    component by Snider (2001) eqs. 39-41 (packing limiter, hfgpu.kernels.closures.particle_stress).
     Walls, per component (x first): a move that would leave the grid, enter a closed cell, enter another cell
     narrower than the parcel's bridging width (bridging_factor x 2 r), or raise the
     parcel's bilinear weight on a cell whose theta_p (this step's scatter, less the parcel's own deposit with
@@ -359,17 +359,22 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     half_rate = 0.5 * seen.damping_rate
     buoyant_g = (1.0 - fluid_density / rho_p) * gravity
     u_new, v_new = parcels.u, parcels.v
-    for _ in range(params.drag_iterations):
-        slip = np.hypot(seen.fluid_u - u_new, seen.fluid_v - v_new)
-        drag = closures.drag_rate(slip, parcels.radius, rho_p, theta, fluid_density, fluid_viscosity, params)
-        den = 1.0 + dt * (drag + half_rate)
-        u_new = (parcels.u + dt * (drag * seen.fluid_u - seen.dpdx / rho_p + half_rate * seen.mean_u)) / den
-        v_new = (parcels.v + dt * (drag * seen.fluid_v - seen.dpdz / rho_p + buoyant_g
-                                   + half_rate * seen.mean_v)) / den
+    if params.damping_scheme == "relaxation":
+        u_new, v_new, drag, den, mean_u, mean_v = _relaxation_velocity(parcels, seen, dt, params, fluid_density,
+                                                                       fluid_viscosity, buoyant_g)
+    else:
+        for _ in range(params.drag_iterations):
+            slip = np.hypot(seen.fluid_u - u_new, seen.fluid_v - v_new)
+            drag = closures.drag_rate(slip, parcels.radius, rho_p, theta, fluid_density, fluid_viscosity, params)
+            den = 1.0 + dt * (drag + half_rate)
+            u_new = (parcels.u + dt * (drag * seen.fluid_u - seen.dpdx / rho_p + half_rate * seen.mean_u)) / den
+            v_new = (parcels.v + dt * (drag * seen.fluid_v - seen.dpdz / rho_p + buoyant_g
+                                       + half_rate * seen.mean_v)) / den
+        mean_u, mean_v = seen.mean_u, seen.mean_v
     scale = -dt / (np.maximum(theta, params.epsilon) * rho_p * den)
-    u_new = u_new + packing_limiter_numpy(scale * seen.dtaudx, seen.mean_u - u_new, seen.dtaudx,
+    u_new = u_new + packing_limiter_numpy(scale * seen.dtaudx, mean_u - u_new, seen.dtaudx,
                                           params.packing_restitution)
-    v_new = v_new + packing_limiter_numpy(scale * seen.dtaudz, seen.mean_v - v_new, seen.dtaudz,
+    v_new = v_new + packing_limiter_numpy(scale * seen.dtaudz, mean_v - v_new, seen.dtaudz,
                                           params.packing_restitution)
     resting = on_bed(parcels.x, parcels.z, parcels.radius, frame, fields.width, fields.volume_fraction, params)
     friction = bed_friction(parcels, frame, fields, buoyant_g, params)
@@ -402,6 +407,31 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     parcels.v[:] = v_new
     parcels.state[:] = np.where(bridged, BRIDGED, SUSPENDED)
     return drag
+
+
+def _relaxation_velocity(parcels: Parcels, seen: ParcelFluid, dt: float, params: MppicParams, fluid_density: float,
+                         fluid_viscosity: float, buoyant_g: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The velocity step of damping_scheme "relaxation" (hfgpu.kernels.closures.damping.DAMPING_SCHEMES): the old
+    velocity relaxed towards the cell's mean, u' = u^o + dt h / (1 + dt h) (<u> - u^o), h = 1/(2 tau_D), then
+    u = (u' + dt (D u_f + a)) / (1 + dt D), D iterated as in push. Returns (u, v, D, 1 + dt D, and the mean
+    moved by the same step, (<u> + dt (D u_f + a)) / (1 + dt D), which bounds the packing limiter)."""
+    rho_p = parcels.density
+    half_rate = 0.5 * seen.damping_rate
+    keep = dt * half_rate / (1.0 + dt * half_rate)
+    damped_u = parcels.u + keep * (seen.mean_u - parcels.u)
+    damped_v = parcels.v + keep * (seen.mean_v - parcels.v)
+    push_u = -dt * seen.dpdx / rho_p
+    push_v = dt * (buoyant_g - seen.dpdz / rho_p)
+    u_new, v_new = parcels.u, parcels.v
+    for _ in range(params.drag_iterations):
+        slip = np.hypot(seen.fluid_u - u_new, seen.fluid_v - v_new)
+        drag = closures.drag_rate(slip, parcels.radius, rho_p, seen.volume_fraction, fluid_density,
+                                  fluid_viscosity, params)
+        den = 1.0 + dt * drag
+        u_new = (damped_u + push_u + dt * drag * seen.fluid_u) / den
+        v_new = (damped_v + push_v + dt * drag * seen.fluid_v) / den
+    return (u_new, v_new, drag, den, (seen.mean_u + push_u + dt * drag * seen.fluid_u) / den,
+            (seen.mean_v + push_v + dt * drag * seen.fluid_v) / den)
 
 
 def exchange(parcels: Parcels, seen: ParcelFluid, drag: np.ndarray, frame: GridFrame,

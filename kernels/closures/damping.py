@@ -13,6 +13,12 @@ from hfgpu.kernels.closures.particle_stress import stress_denominator, stress_de
 from hfgpu.kernels.closures.twin import ti
 
 SQRT_3PI = 3.0699801238394655  # sqrt(3 pi)
+#: How the push applies the rate h = 1/(2 tau_D) (particle_ops_numpy.push, kernels/particles.py velocity_lanes):
+#: "implicit" = O'Rourke & Snider (2010), u = (u^o + dt (D u_f + a + h <u>)) / (1 + dt (D + h)), the cell's mean
+#: <u> from the step before; "relaxation" = the old velocity relaxed towards <u>, u^o + dt h / (1 + dt h)
+#: (<u> - u^o), then the drag step with 1 + dt D, which keeps the cell's mean answer to drag and gravity
+#: (docs/proppant-closures.md, "Collision damping in a dense cell").
+DAMPING_SCHEMES = ("implicit", "relaxation")
 
 
 def damping_rate_numpy(theta_p, velocity_variance, sauter_radius, enabled, restitution, threshold, theta_cp,

@@ -33,7 +33,7 @@ PARAM_SLOTS = {"P_X0": "x0", "P_Z0": "z0", "P_DX": "dx", "P_DZ": "dz", "P_THETA_
                "P_SHIELDS": "shields_deposition", "P_WALL_LAW": "wall_friction_code", "P_RHO_F": "rho_f",
                "P_MU": "mu_f", "P_GRAVITY": "gravity", "P_STRESS_P": "P_s", "P_STRESS_BETA": "beta",
                "P_RESTITUTION": "restitution", "P_DAMPING": "damping", "P_DAMPING_THRESHOLD": "damping_threshold",
-               "P_AVERAGING": "averaging_code"}
+               "P_DAMPING_SCHEME": "damping_scheme_code", "P_AVERAGING": "averaging_code"}
 
 
 def test_parcel_fluid_fields_are_the_seen_rows():
@@ -96,7 +96,7 @@ def distinctive_params() -> MppicParams:
     return dataclasses.replace(
         MppicParams(), theta_cp=0.61, P_s=4.5, beta=2.5, epsilon=3e-7, restitution=0.85, drag_law="snider",
         drag_re_coefficient=0.17, bridging_factor=2.3, drag_iterations=5, packing_restitution=0.1, damping=False,
-        damping_threshold=0.45, bed_friction=0.6, bed_stress="grain", bed_slope=True,
+        damping_threshold=0.45, damping_scheme="relaxation", bed_friction=0.6, bed_stress="grain", bed_slope=True,
         friction_volume_fraction=0.52,
         wall_friction="dean", shields_deposition=False)
 
