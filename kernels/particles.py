@@ -294,7 +294,7 @@ def velocity_lanes(p0: ti.i32, n: ti.i32, P: ti.template(), s: ti.template(), dt
     push_u = -dt * dpdx * inv_rho
     push_v = dt * (buoyant_g - dpdz * inv_rho)
     relaxation = PR[P_DAMPING_SCHEME] > 0.0
-    if relaxation:  # closures.damping.DAMPING_SCHEMES, particle_ops_numpy._relaxation_velocity
+    if relaxation:  # closures.damping.DAMPING_SCHEMES, particle_ops_numpy.velocity_step
         keep = dt * half_rate / (1.0 + dt * half_rate)
         force_u = u0 + keep * (mean_u - u0) + push_u
         force_v = v0 + keep * (mean_v - v0) + push_v
@@ -373,7 +373,7 @@ def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(),
     if not flag & LOOSE:
         if on_bed(sx, sz, P[RADIUS, p], PR[P_DZ], C, dense) > 0.0:
             den = 1.0 + dt * (W[DRAG, p] + 0.5 * W[S_DAMPING, p])
-            if PR[P_DAMPING_SCHEME] > 0.0:
+            if PR[P_DAMPING_SCHEME] > 0.0 or PR[P_BED_SLOPE] > 0.0:
                 den = 1.0 + dt * W[DRAG, p]
             k, i = owner(sx, sz)
             friction = ti.max(PR[P_BED_FRICTION] * ti.abs((1.0 - rho_f / P[DENSITY, p]) * gravity),
@@ -388,7 +388,6 @@ def push_parcel(p: ti.i32, P: ti.template(), S: ti.template(), W: ti.template(),
             if PR[P_BED_SLOPE] > 0.0:
                 if not surface or held:
                     slope = bed.slope_acceleration(sx, sz, P[DENSITY, p], C, PR[P_THETA_CP], PR[P_DX])
-                den = 1.0 + dt * W[DRAG, p]
                 P[U, p] += dt * slope / den
             P[U, p] = bed.bed_friction(P[U, p], friction, dt, den)
             if PR[P_SHIELDS] > 0.0 and held:

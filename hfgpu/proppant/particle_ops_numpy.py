@@ -331,7 +331,7 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     Velocity: u~ = (u^o + dt (D u_f - grad p / rho_p + (1 - rho_f/rho_p) g + <u>/(2 tau_D))) /
     (1 + dt (D + 1/(2 tau_D))), drag D(|u_f - u|) iterated ``drag_iterations`` times starting from u^o (the
     returned D is the one of the last solve); with damping_scheme "relaxation" the damping acts first instead
-    (:func:`_relaxation_velocity`). Then the stress term -dt grad tau / (theta_p rho_p (1 + ...)), limited per
+    (:func:`velocity_step`). Then the stress term -dt grad tau / (theta_p rho_p (1 + ...)), limited per
     component by Snider (2001) eqs. 39-41 (packing limiter, hfgpu.kernels.closures.particle_stress).
     Walls, per component (x first): a move that would leave the grid, enter a closed cell, enter another cell
     narrower than the parcel's bridging width (bridging_factor x 2 r), or raise the
@@ -356,21 +356,9 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     """
     rho_p = parcels.density
     theta = seen.volume_fraction
-    half_rate = 0.5 * seen.damping_rate
     buoyant_g = (1.0 - fluid_density / rho_p) * gravity
-    u_new, v_new = parcels.u, parcels.v
-    if params.damping_scheme == "relaxation":
-        u_new, v_new, drag, den, mean_u, mean_v = _relaxation_velocity(parcels, seen, dt, params, fluid_density,
-                                                                       fluid_viscosity, buoyant_g)
-    else:
-        for _ in range(params.drag_iterations):
-            slip = np.hypot(seen.fluid_u - u_new, seen.fluid_v - v_new)
-            drag = closures.drag_rate(slip, parcels.radius, rho_p, theta, fluid_density, fluid_viscosity, params)
-            den = 1.0 + dt * (drag + half_rate)
-            u_new = (parcels.u + dt * (drag * seen.fluid_u - seen.dpdx / rho_p + half_rate * seen.mean_u)) / den
-            v_new = (parcels.v + dt * (drag * seen.fluid_v - seen.dpdz / rho_p + buoyant_g
-                                       + half_rate * seen.mean_v)) / den
-        mean_u, mean_v = seen.mean_u, seen.mean_v
+    u_new, v_new, drag, den, mean_u, mean_v = velocity_step(parcels, seen, dt, params, fluid_density,
+                                                            fluid_viscosity, buoyant_g)
     scale = -dt / (np.maximum(theta, params.epsilon) * rho_p * den)
     u_new = u_new + packing_limiter_numpy(scale * seen.dtaudx, mean_u - u_new, seen.dtaudx,
                                           params.packing_restitution)
@@ -409,29 +397,39 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     return drag
 
 
-def _relaxation_velocity(parcels: Parcels, seen: ParcelFluid, dt: float, params: MppicParams, fluid_density: float,
-                         fluid_viscosity: float, buoyant_g: np.ndarray) -> tuple[np.ndarray, ...]:
-    """The velocity step of damping_scheme "relaxation" (hfgpu.kernels.closures.damping.DAMPING_SCHEMES): the old
-    velocity relaxed towards the cell's mean, u' = u^o + dt h / (1 + dt h) (<u> - u^o), h = 1/(2 tau_D), then
-    u = (u' + dt (D u_f + a)) / (1 + dt D), D iterated as in push. Returns (u, v, D, 1 + dt D, and the mean
-    moved by the same step, (<u> + dt (D u_f + a)) / (1 + dt D), which bounds the packing limiter)."""
+def velocity_step(parcels: Parcels, seen: ParcelFluid, dt: float, params: MppicParams, fluid_density: float,
+                  fluid_viscosity: float, buoyant_g: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The drag solve of :func:`push` with the collision damping, h = 1/(2 tau_D), as ``params.damping_scheme``
+    names it (hfgpu.kernels.closures.damping.DAMPING_SCHEMES):
+
+    - "implicit": u = (u^o + dt (D u_f + a + h <u>)) / (1 + dt (D + h));
+    - "relaxation": the old velocity relaxed towards the cell's mean first, u' = u^o + dt h / (1 + dt h)
+      (<u> - u^o), then u = (u' + dt (D u_f + a)) / (1 + dt D).
+
+    a = -grad p / rho_p (+ the buoyant weight along z), D iterated ``drag_iterations`` times from u^o. Returns (u,
+    v, D, the denominator, and the mean velocity that bounds the packing limiter: <u> with "implicit", the mean
+    moved by the same step, (<u> + dt (D u_f + a)) / (1 + dt D), with "relaxation")."""
     rho_p = parcels.density
     half_rate = 0.5 * seen.damping_rate
-    keep = dt * half_rate / (1.0 + dt * half_rate)
-    damped_u = parcels.u + keep * (seen.mean_u - parcels.u)
-    damped_v = parcels.v + keep * (seen.mean_v - parcels.v)
-    push_u = -dt * seen.dpdx / rho_p
-    push_v = dt * (buoyant_g - seen.dpdz / rho_p)
+    relaxation = params.damping_scheme == "relaxation"
+    start_u, start_v, rate = parcels.u, parcels.v, half_rate   # rate: h inside the drag's denominator
+    if relaxation:
+        keep = dt * half_rate / (1.0 + dt * half_rate)
+        start_u = parcels.u + keep * (seen.mean_u - parcels.u)
+        start_v = parcels.v + keep * (seen.mean_v - parcels.v)
+        rate = 0.0
     u_new, v_new = parcels.u, parcels.v
     for _ in range(params.drag_iterations):
         slip = np.hypot(seen.fluid_u - u_new, seen.fluid_v - v_new)
         drag = closures.drag_rate(slip, parcels.radius, rho_p, seen.volume_fraction, fluid_density,
                                   fluid_viscosity, params)
-        den = 1.0 + dt * drag
-        u_new = (damped_u + push_u + dt * drag * seen.fluid_u) / den
-        v_new = (damped_v + push_v + dt * drag * seen.fluid_v) / den
-    return (u_new, v_new, drag, den, (seen.mean_u + push_u + dt * drag * seen.fluid_u) / den,
-            (seen.mean_v + push_v + dt * drag * seen.fluid_v) / den)
+        den = 1.0 + dt * (drag + rate)
+        u_new = (start_u + dt * (drag * seen.fluid_u - seen.dpdx / rho_p + rate * seen.mean_u)) / den
+        v_new = (start_v + dt * (drag * seen.fluid_v - seen.dpdz / rho_p + buoyant_g + rate * seen.mean_v)) / den
+    if not relaxation:
+        return u_new, v_new, drag, den, seen.mean_u, seen.mean_v
+    return (u_new, v_new, drag, den, (seen.mean_u + dt * (drag * seen.fluid_u - seen.dpdx / rho_p)) / den,
+            (seen.mean_v + dt * (drag * seen.fluid_v - seen.dpdz / rho_p + buoyant_g)) / den)
 
 
 def exchange(parcels: Parcels, seen: ParcelFluid, drag: np.ndarray, frame: GridFrame,

@@ -33,20 +33,11 @@ def cell_of_grains(rate: float) -> tuple[Parcels, ref.ParcelFluid]:
 
 
 def velocities(scheme: str, rate: float) -> tuple[np.ndarray, np.ndarray]:
-    """The push's velocity step (the drag solve of particle_ops_numpy.push, before the limiter and the walls)."""
+    """The push's velocity step (particle_ops_numpy.velocity_step, before the limiter and the walls)."""
     parcels, seen = cell_of_grains(rate)
     params = MppicParams(damping_scheme=scheme, drag_re_coefficient=0.0)
     buoyant_g = (1.0 - RHO_F / parcels.density) * G
-    if scheme == "relaxation":
-        u, v = ref._relaxation_velocity(parcels, seen, DT, params, RHO_F, MU, buoyant_g)[:2]
-        return u, v
-    half = 0.5 * rate
-    drag = ref.closures.drag_rate(np.zeros(N), parcels.radius, parcels.density, seen.volume_fraction, RHO_F, MU,
-                                  params)
-    den = 1.0 + DT * (drag + half)
-    return ((parcels.u + DT * (drag * seen.fluid_u + half * seen.mean_u)) / den,
-            (parcels.v + DT * (drag * seen.fluid_v - seen.dpdz / parcels.density + buoyant_g + half * seen.mean_v))
-            / den)
+    return ref.velocity_step(parcels, seen, DT, params, RHO_F, MU, buoyant_g)[:2]
 
 
 def test_relaxation_keeps_the_mean_answer_and_damps_the_spread():
