@@ -283,10 +283,12 @@ def column_scene_text(end: float, extra: str = "") -> str:
     return scene_head(end, 'viscosity = "1 cP"', "box", PILE_L, PILE_H) + sand_lines(extra)
 
 
-def collapse(end: float = 3.0, columns: int = 4, rows: int = 12, extra: str = "", quiet: bool = False) -> dict:
+def collapse(end: float = 3.0, columns: int = 4, rows: int = 12, extra: str = "", quiet: bool = False,
+             since: float | None = None) -> dict:
     """Release a packed column of sand (theta_p 0.58, ``columns`` cells wide, ``rows`` cells high, a 4 x 4
     lattice of parcels a cell) standing on the floor in the middle of the closed slot of ``pour``, in water at
-    rest, and measure its surface and flank angles at ``end`` as ``pour`` does."""
+    rest, and measure its surface and flank angles at ``end`` as ``pour`` does; with ``since``, also how far the
+    surface moved from ``since`` to ``end`` ("moved", the largest change of a column's height [m])."""
     sim = ProppantSimulation(proppant_engine_setup(load_scene(column_scene_text(end, extra))))
     q = 4
     nx = round(PILE_L / DZ)
@@ -296,18 +298,25 @@ def collapse(end: float = 3.0, columns: int = 4, rows: int = 12, extra: str = ""
     sim.set_parcels(Parcels.create(x.ravel(), z.ravel(), radius=D / 2, density=RHO_P, particles=per))
     sim.fluid = sim.solver.initial_state(sim._fluid_theta_p())
     before = surface(sim.moments.volume_fraction, 0.5 * sim.params.theta_cp)
-    while sim.time < end - 1e-9:
-        sim.step(limit=end - sim.time)
-    heights = surface(sim.moments.volume_fraction, 0.5 * sim.params.theta_cp)
+
+    def heights_at(stop: float) -> np.ndarray:
+        while sim.time < stop - 1e-9:
+            sim.step(limit=stop - sim.time)
+        return surface(sim.moments.volume_fraction, 0.5 * sim.params.theta_cp)
+
+    earlier = heights_at(since) if since is not None else before
+    heights = heights_at(end)
     top, left_angle, right_angle = flank_angles(heights)
     p = sim.parcels
     r = {"end": end, "peak": top, "left": left_angle, "right": right_angle, "angle": 0.5 * (left_angle + right_angle),
-         "heights": heights, "before": before, "speed_max": float(np.hypot(p.u, p.v).max())}
+         "heights": heights, "before": before, "speed_max": float(np.hypot(p.u, p.v).max()),
+         "moved": float(np.abs(heights - earlier).max())}
     if not quiet:
         print("column at 0 s: surface heights [mm] " + " ".join(f"{1e3 * h:.1f}" for h in before))
         print(f"column at {end:g} s: surface heights [mm] " + " ".join(f"{1e3 * h:.1f}" for h in heights))
         print(f"peak {1e3 * top:.1f} mm, flank angles {left_angle:.1f} / {right_angle:.1f} deg; fastest grain "
-              f"{r['speed_max']:.3g} m/s", flush=True)
+              f"{r['speed_max']:.3g} m/s" + (f"; surface moved {1e3 * r['moved']:.2f} mm since {since:g} s"
+                                             if since is not None else ""), flush=True)
     return r
 
 

@@ -143,7 +143,7 @@ class MppicNumerics:
     gravity: float = 9.81
     slurry_viscosity: bool = True
     initial_placement: str = "lattice"
-    grain_pressure: str = "last"
+    grain_pressure: str = "two-step"
 
 
 @dataclass(frozen=True)

@@ -102,7 +102,7 @@ class MppicParams:
     drag_iterations: int = 3
     packing_restitution: float = 0.0
     damping: bool = True
-    damping_scheme: str = "implicit"
+    damping_scheme: str = "relaxation"
     damping_threshold: float = 0.5
     bed_friction: float = 0.543
     bed_stress: str = "grain"

@@ -145,10 +145,10 @@ def test_field_geometry_from_npz(tmp_path):
 
 
 def test_grain_pressure_key():
-    """[mppic] grain_pressure: default "last", "two-step" accepted, another value refused in one line naming the
+    """[mppic] grain_pressure: default "two-step", "last" accepted, another value refused in one line naming the
     key, the value and the allowed ones."""
-    assert load_scene(BOX).proppant.numerics.grain_pressure == "last"
-    assert load_scene(BOX + 'grain_pressure = "two-step"\n').proppant.numerics.grain_pressure == "two-step"
+    assert load_scene(BOX).proppant.numerics.grain_pressure == "two-step"
+    assert load_scene(BOX + 'grain_pressure = "last"\n').proppant.numerics.grain_pressure == "last"
     with pytest.raises(SceneError) as err:
         load_scene(BOX + 'grain_pressure = "mean"\n')
     assert "mppic.grain_pressure" in str(err.value) and "'mean'" in str(err.value) and "two-step" in str(err.value)

@@ -61,7 +61,7 @@ def test_implicit_damping_slows_the_mean():
 
 
 def test_damping_scheme_key():
-    assert MppicParams().damping_scheme == "implicit"
+    assert MppicParams().damping_scheme == "relaxation"
     with pytest.raises(SceneError) as err:
         MppicParams(damping_scheme="explicit")
     assert str(err.value) == ("scene key 'mppic.damping_scheme': got 'explicit'; allowed: one of "
