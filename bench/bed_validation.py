@@ -51,6 +51,7 @@ import numpy as np
 
 from hfgpu import load_scene
 from hfgpu.kernels.closures import bed
+from hfgpu.proppant.analysis import alternation
 from hfgpu.proppant.parcels import Parcels
 from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
@@ -270,13 +271,20 @@ def pour(end: float = 8.0, extra: str = "", quiet: bool = False, rest: float = 0
     p = sim.parcels
     in_pile = p.z > PILE_H - top
     r = {"end": end, "parcels": p.n, "peak": top, "left": left, "right": right, "angle": 0.5 * (left + right),
-         "heights": heights, "pile_speed_max": float(np.hypot(p.u, p.v)[in_pile].max()) if in_pile.any() else 0.0}
+         "heights": heights, "pile_speed_max": float(np.hypot(p.u, p.v)[in_pile].max()) if in_pile.any() else 0.0,
+         "alternation": alternation(theta)}
     if not quiet:
         print(f"pile at {end:g} s ({p.n} parcels): surface heights [mm] " + " ".join(f"{1e3 * h:.1f}" for h in heights))
         print(f"peak {1e3 * top:.1f} mm, flank angles {left:.1f} / {right:.1f} deg (mean {r['angle']:.1f}); "
               f"fastest grain in the pile {r['pile_speed_max']:.3g} m/s; published: "
               + ", ".join(f"{k} {v:g} deg" for k, v in PUBLISHED.items()), flush=True)
+        print_packing(theta, r["alternation"])
     return r
+
+
+def print_packing(theta: np.ndarray, counted: tuple[int, float]) -> None:
+    print(f"packing: theta_p up to {theta.max():.3f}; of the {counted[0]} dense cells with dense neighbours along x, "
+          f"{100 * counted[1]:.0f} % a local extreme along x by > 0.05", flush=True)
 
 
 def column_scene_text(end: float, extra: str = "") -> str:
@@ -310,13 +318,14 @@ def collapse(end: float = 3.0, columns: int = 4, rows: int = 12, extra: str = ""
     p = sim.parcels
     r = {"end": end, "peak": top, "left": left_angle, "right": right_angle, "angle": 0.5 * (left_angle + right_angle),
          "heights": heights, "before": before, "speed_max": float(np.hypot(p.u, p.v).max()),
-         "moved": float(np.abs(heights - earlier).max())}
+         "moved": float(np.abs(heights - earlier).max()), "alternation": alternation(sim.moments.volume_fraction)}
     if not quiet:
         print("column at 0 s: surface heights [mm] " + " ".join(f"{1e3 * h:.1f}" for h in before))
         print(f"column at {end:g} s: surface heights [mm] " + " ".join(f"{1e3 * h:.1f}" for h in heights))
         print(f"peak {1e3 * top:.1f} mm, flank angles {left_angle:.1f} / {right_angle:.1f} deg; fastest grain "
               f"{r['speed_max']:.3g} m/s" + (f"; surface moved {1e3 * r['moved']:.2f} mm since {since:g} s"
                                              if since is not None else ""), flush=True)
+        print_packing(sim.moments.volume_fraction, r["alternation"])
     return r
 
 

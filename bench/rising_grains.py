@@ -4,7 +4,8 @@ the five-layer run"), read from the proppant snapshots of results files, or from
 A parcel is in a dense cell where theta_p of the cell that owns it is at least ``--dense`` (0.5, the
 ``friction_volume_fraction`` at which the model treats a cell as a contact network); it rises where its depth
 velocity v < -``--speed`` (1 mm/s; depth grows downwards). For each file the table gives the parcel-snapshots in
-dense cells, those rising, the fastest, and the snapshot and cell (row k, column i) that holds the most.
+dense cells, those rising, the fastest, the snapshot and cell (row k, column i) that holds the most, and how far the
+last snapshot's packing alternates from cell to cell (hfgpu.proppant.analysis.alternation).
 
     python bench/rising_grains.py results.h5 [more.h5 ...]
     python bench/rising_grains.py --scene hfgpu/scenes/five_layer.toml --out rising_output   # runs it (~1 min)
@@ -25,11 +26,12 @@ import numpy as np
 from hfgpu import load_scene, open_results, run
 from hfgpu.kernels.stencil_numpy import owning_cell
 from hfgpu.scene_text import assignment, edit_scene
+from hfgpu.proppant.analysis import alternation
 
 
 def rising(path: Path, dense: float, speed: float) -> dict:
     """Counts over every proppant snapshot of the results file ``path``."""
-    total, up, fastest, where = 0, 0, 0.0, Counter()
+    total, up, fastest, where, theta = 0, 0, 0.0, Counter(), None
     for snap in open_results(path).proppant_snapshots:
         theta = np.asarray(snap.grid["volume_fraction"])
         p = snap.parcels
@@ -43,7 +45,8 @@ def rising(path: Path, dense: float, speed: float) -> dict:
         if lifted.any():
             fastest = max(fastest, float(-p["v"][lifted].min()))
             where.update((snap.time, int(a), int(b)) for a, b in zip(k[lifted], i[lifted]))
-    return dict(total=total, up=up, fastest=fastest, where=where.most_common(1))
+    return dict(total=total, up=up, fastest=fastest, where=where.most_common(1),
+                alternation=alternation(theta) if theta is not None else (0, 0.0))
 
 
 def main() -> None:
@@ -68,12 +71,15 @@ def main() -> None:
         parser.error("give results files or --scene")
     print(f"parcels in cells at theta_p >= {args.dense:g} rising faster than {args.speed * 1e3:g} mm/s, "
           "over the proppant snapshots")
-    print("| results | dense parcel-snapshots | rising | fastest [mm/s] | most at (time [s], k, i): count |")
-    print("|---|---|---|---|---|")
+    print("| results | dense parcel-snapshots | rising | fastest [mm/s] | most at (time [s], k, i): count | "
+          "alternating at the end |")
+    print("|---|---|---|---|---|---|")
     for path in paths:
         r = rising(path, args.dense, args.speed)
         most = "; ".join(f"({t:g}, {k}, {i}): {n}" for (t, k, i), n in r["where"]) or "-"
-        print(f"| {path} | {r['total']} | {r['up']} | {1e3 * r['fastest']:.1f} | {most} |", flush=True)
+        cells, share = r["alternation"]
+        print(f"| {path} | {r['total']} | {r['up']} | {1e3 * r['fastest']:.1f} | {most} | "
+              f"{100 * share:.0f} % of {cells} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -76,3 +76,13 @@ def bed_height(volume_fraction: np.ndarray, width: np.ndarray, frame: GridFrame,
     of the column times dz (the paper's Fig. 10 bed profiles)."""
     is_bank = (volume_fraction >= threshold) & (width > 0.0)
     return np.count_nonzero(is_bank, axis=0) * frame.dz
+
+
+def alternation(volume_fraction: np.ndarray, dense: float = 0.4, by: float = 0.05) -> tuple[int, float]:
+    """How far a bed's packing alternates from cell to cell: the number of dense cells (theta_p >= ``dense``, both
+    neighbours along x too) and the share of them that are a local extreme of theta_p along x by more than
+    ``by`` (theta_i - max(theta_i-1, theta_i+1) > by, or min(...) - theta_i > by)."""
+    centre, left, right = volume_fraction[:, 1:-1], volume_fraction[:, :-2], volume_fraction[:, 2:]
+    cells = (centre >= dense) & (left >= dense) & (right >= dense)
+    extreme = (centre - np.maximum(left, right) > by) | (np.minimum(left, right) - centre > by)
+    return int(cells.sum()), float((extreme & cells).sum() / max(cells.sum(), 1))

@@ -118,8 +118,8 @@ class MppicNumerics:
     initial_placement: where the initial suspension's parcels sit in their cells, "lattice" (a quiet start:
     theta_p starts without sampling noise) or "stratified" (random; hfgpu.proppant.injection.initial_suspension).
     grain_pressure: the fluid pressure the parcels take during a fluid step (simulator.ProppantSimulation.step):
-    "last" = that of the fluid step before, "two-step" = the mean of the two fluid steps before, which cancels a
-    pressure that changes sign from one step to the next (docs/proppant-closures.md, "Pressure the grains take").
+    "two-step" (default) = the mean of the two fluid steps before, which cancels a pressure that changes sign
+    from one step to the next, "last" = that of the fluid step before (docs/proppant-closures.md, "Pressure the grains take").
     slurry_viscosity: the fluid phase uses the slurry viscosity of Eq. 10 (MppicParams.viscosity_law); false
     uses the clean-fluid viscosity. Eq. 10 diverges at close packing; the momentum predictor takes the
     in-plane diffusion and wall friction implicitly and MppicParams.max_relative_viscosity caps mu_f / mu_0,

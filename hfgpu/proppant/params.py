@@ -42,9 +42,10 @@ class MppicParams:
     driven into a denser region faster than the mean parcel velocity is sent back at most e times its
     relative velocity. Default 0 (inelastic): a bed whose stress carries its weight is then exactly at rest.
     damping: collision damping on/off; active only where theta_p > damping_threshold x theta_cp.
-    damping_scheme: how the push applies it (hfgpu.kernels.closures.damping.DAMPING_SCHEMES): "implicit"
-    (O'Rourke & Snider 2010, inside the drag's denominator) or "relaxation" (the old velocity relaxed towards
-    the cell's mean, then the drag step: the cell's mean answers drag and gravity as without damping).
+    damping_scheme: how the push applies it (hfgpu.kernels.closures.damping.DAMPING_SCHEMES): "relaxation"
+    (default: the old velocity relaxed towards the cell's mean, then the drag step; the cell's mean answers drag
+    and gravity as without damping) or "implicit" (O'Rourke & Snider 2010, inside the drag's denominator, which
+    slows the mean's answer by (1 + dt (D + h)) / (1 + dt D)).
     bed_friction: Coulomb friction coefficient mu_b of a parcel resting in or on a dense bed (push,
     hfgpu.kernels.closures.bed): its velocity along the bed (x, normal to gravity) loses at most
     dt mu_b |1 - rho_f/rho_p| g per step (the friction its own submerged weight can mobilise), so a resting grain

@@ -6,7 +6,10 @@ this family says what the bed does.
 Bed friction, in the implicit velocity update of Eq. 43: a friction force per unit mass a_f opposes the motion
 along the bed (x, normal to gravity) and, being static friction, at most cancels it:
 
-    u <- sign(u) max(|u| - dt a_f / den, 0),    den = 1 + dt (D_p + 1 / (2 tau_D)) (Eq. 43's).
+    u <- sign(u) max(|u| - dt a_f / den, 0),
+
+den the push's drag denominator: 1 + dt D_p (damping_scheme "relaxation", and with bed_slope), or
+1 + dt (D_p + 1 / (2 tau_D)) (damping_scheme "implicit", Eq. 43's).
 
 What presses the grain onto the bed (``bed_stress``, BED_STRESSES):
 

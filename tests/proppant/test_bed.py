@@ -84,10 +84,10 @@ def test_settled_bed_parcels_at_rest(settled):
     rate is nu (12/w^2 + pi^2/L^2 + pi^2/H_clear^2) = 0.24 1/s (Eq. 9 wall friction of the 1 cm gap plus
     in-plane diffusion over the 1 cm x 2 cm clear fluid; measured 0.26 1/s at 8-14 s; the grains' speeds
     0.14-0.31 1/s), and grains in a surface cell still consolidating under Eq. 16 sink (e-folding ~3 s).
-    Over 30 seeds the maximum is above 1e-6 m/s in 9 at 4 s (up to 1.1e-4), 3 at 6 s, 1 at 10 s and none
-    from 12 s; at 16 s it is at most 2.5e-7 over 60 seeds (these counts without the threshold of motion on the bed
-    surface; this seed: 1.5e-6 at 4 s, 4e-12 at 16 s without it, 1.3e-7 and 3e-18 with it, the default;
-    docs/proppant-closures.md, "Implicit drag on the fluid" and "Threshold of motion")."""
+    This box (the quiet start, "lattice") is at rest, every parcel at 0 m/s, from 4 s. With random placement
+    ("stratified"), over 30 seeds the maximum is above 1e-6 m/s in 13 at 4 s (up to 1.2e-4), 7 at 10 s and 2 at
+    16 s (6.6e-6 and 1.2e-6, surface grains), the bed below its surface rows at 0 m/s in all
+    (`python bench/settled_bed.py --seeds 30`; docs/proppant-closures.md, "Threshold of motion")."""
     speed = np.hypot(settled.parcels.u, settled.parcels.v)
     assert speed.max() < 1e-6
 
