@@ -13,6 +13,7 @@ the wall time.
     python bench/bench_column.py --placement lattice stratified --averaging dual moment --end 100
     python bench/bench_column.py --columns 1 --averaging dual moment basic --end 100   # one column
     python bench/bench_column.py --gap 4mm --end 970               # a 10-column slot to half its settling time
+    python bench/bench_column.py --set 'damping_scheme="implicit"'   # an [mppic] key
 """
 
 from __future__ import annotations
@@ -60,9 +61,10 @@ averaging = "{averaging}"
 THETA0 = 0.06
 
 
-def run(columns: int, gap: str, placement: str, averaging: str, end: float) -> dict:
-    """One box to ``end`` [s]; the row of the table."""
-    scene = load_scene(SCENE.format(end=end, length=4 * columns, gap=gap, placement=placement, averaging=averaging))
+def run(columns: int, gap: str, placement: str, averaging: str, end: float, extra: tuple[str, ...] = ()) -> dict:
+    """One box to ``end`` [s], with the [mppic] lines ``extra``; the row of the table."""
+    scene = load_scene(SCENE.format(end=end, length=4 * columns, gap=gap, placement=placement, averaging=averaging)
+                       + "".join(f"{line}\n" for line in extra))
     sim = ProppantSimulation(proppant_engine_setup(scene))
     cls = sim.setup.classes[0]
     hindered = settling.hindered_velocity(settling.stokes_velocity(cls.size.mean, cls.density, sim.rho_f, sim.mu_f),
@@ -92,13 +94,15 @@ def main() -> None:
     parser.add_argument("--placement", nargs="+", default=["lattice"])
     parser.add_argument("--averaging", nargs="+", default=["dual"])
     parser.add_argument("--end", type=float, default=100.0)
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="an [mppic] key, e.g. --set 'damping_scheme=\"implicit\"'")
     args = parser.parse_args()
     print(f"{args.columns} column(s) of 4 mm, gap {args.gap}, 6 % 120 um beads, to {args.end:g} s")
     print("| placement | averaging | onset [s] | end |u_f| [m/s] | interface depth [mm] | speed vs RZ | "
           "pile-up under it | steps | wall [s] |")
     print("|---|---|---|---|---|---|---|---|---|")
     for placement, name in itertools.product(args.placement, args.averaging):
-        r = run(args.columns, args.gap, placement, name, args.end)
+        r = run(args.columns, args.gap, placement, name, args.end, tuple(args.set))
         onset = "none" if np.isnan(r["onset"]) else f"{r['onset']:.1f}"
         print(f"| {placement} | {name} | {onset} | {r['speed']:.2e} | {1e3 * r['depth']:.1f} | "
               f"{100 * r['rate']:+.1f} % | {100 * r['pile']:+.1f} % | {r['steps']} | {r['wall']:.0f} |", flush=True)
