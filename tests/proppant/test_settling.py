@@ -98,6 +98,7 @@ def test_hindered_settling_richardson_zaki(phi):
     # fit while the interface falls from 5 mm (one cell) to 30 mm, above the rising bed
     speed, bulk = top_interface_speed(text, (0.005 / expected, 0.03 / expected))
     assert speed == pytest.approx(expected, rel=0.05)
-    # the bulk parcels, 1-2 cm above the bed: within 2 % to phi 0.2; at 0.3 measured -4.9 % (the fluid's share
-    # of the pressure gradient is taken face by face, hfgpu.proppant.simulator.pressure_reaction)
-    assert bulk == pytest.approx(expected, rel=0.02 if phi <= 0.2 else 0.06)
+    # the bulk parcels, 1-2 cm above the bed, within 2 % (measured +0.05 / -0.3 / -0.6 / -1.4 % at phi 0.05 / 0.1 /
+    # 0.2 / 0.3; the fluid's share of the pressure gradient is taken face by face,
+    # hfgpu.proppant.simulator.pressure_reaction)
+    assert bulk == pytest.approx(expected, rel=0.02)
