@@ -17,10 +17,10 @@ from hfgpu.propped import shields_ratio
 
 ROOT = Path(__file__).resolve().parents[1]
 END = 1800.0
-#: Propped area at 1800 s, 2.5 m grid over 5 m grid, minus 1: the study measured +0.85 % (8075 -> 8144 m^2,
+#: Propped area at 1800 s, 2.5 m grid over 5 m grid, minus 1: the study measured +2.8 % (7950 -> 8169 m^2,
 #: docs/field-case.md); a second seed moves the 5 m value by 0.3 %, and a different thread count changes the
 #: deposits' summation order and so the parcels' paths, so the band is +-5 points around it.
-PROPPED_CHANGE = (-0.0415, 0.0585)
+PROPPED_CHANGE = (-0.022, 0.078)
 
 
 @pytest.fixture(scope="module")
