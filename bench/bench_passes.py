@@ -60,9 +60,9 @@ def push(P: F2, S: I2, W: F2, C: F3, FLAGS: I2, PR: F1, n: ti.i32, h: ti.f64):
 
 
 @ti.kernel
-def exchange(P: F2, S: I2, W: F2, C: F3, XF: F3, ZF: F3, FLAGS: I2, XD: F4, ZD: F4, BS: F2, PR: F1,
+def exchange(P: F2, S: I2, W: F2, C: F3, XF: F3, ZF: F3, XD: F4, ZD: F4, BS: F2, PR: F1,
              ST: F1, n: ti.i32, blocks: ti.i32, private: ti.template()):
-    particles.exchange_pass(P, S, W, n, C, XF, ZF, FLAGS, XD, ZD, BS, blocks, private, PR, ST, 1)
+    particles.exchange_pass(P, S, W, n, C, XF, ZF, XD, ZD, BS, blocks, private, PR, ST, 1)
 
 
 @ti.kernel
@@ -84,7 +84,7 @@ def calls(engine) -> dict:
         "cell fields": lambda: cells(e._cells, e._cd, e._xf, e._zf, e._flags, e._params, copies),
         "gather": lambda: gather(P, S, e._work_rows, e._cells, e._xf, e._zf, e._flags, e._params, e.n),
         "push": lambda: push(P, S, e._work_rows, e._cells, e._flags, e._params, e.n, h),
-        "exchange": lambda: exchange(P, S, e._work_rows, e._cells, e._xf, e._zf, e._flags, e._xd, e._zd,
+        "exchange": lambda: exchange(P, S, e._work_rows, e._cells, e._xf, e._zf, e._xd, e._zd,
                                      e._block_sums, e._params, e._stats, e.n, blocks, e.private),
         "face means": lambda: faces(e._cells, e._xf, e._zf, e._xd, e._zd, e._params, copies),
         "whole substep": lambda: launches.substep(P, S, e._work_rows, e._cells, e._xf, e._zf, e._flags, e._cd,
