@@ -332,8 +332,9 @@ def push(parcels: Parcels, seen: ParcelFluid, frame: GridFrame, fields: GridFiel
     towards the cell's mean, u' = u^o + dt h (<u> - u^o) / (1 + dt h), h = 1/(2 tau_D), then
     u~ = (u' + dt (D u_f - grad p / rho_p + (1 - rho_f/rho_p) g)) / (1 + dt D); with "implicit"
     u~ = (u^o + dt (D u_f - grad p / rho_p + (1 - rho_f/rho_p) g + h <u>)) / (1 + dt (D + h)); drag D(|u_f - u|)
-    iterated ``drag_iterations`` times starting from u^o (the returned D is the one of the last solve). Then the stress term -dt grad tau / (theta_p rho_p (1 + ...)), limited per
-    component by Snider (2001) eqs. 39-41 (packing limiter, hfgpu.kernels.closures.particle_stress).
+    iterated ``drag_iterations`` times starting from u^o (the returned D is the one of the last solve). Then the
+    stress term -dt grad tau / (theta_p rho_p (1 + ...)), limited per component by Snider (2001) eqs. 39-41
+    (packing limiter, hfgpu.kernels.closures.particle_stress).
     Walls, per component (x first): a move that would leave the grid, enter a closed cell, enter another cell
     narrower than the parcel's bridging width (bridging_factor x 2 r), or raise the
     parcel's bilinear weight on a cell whose theta_p (this step's scatter, less the parcel's own deposit with

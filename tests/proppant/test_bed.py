@@ -5,6 +5,9 @@ decayed and the surface cells have consolidated: the box is settled for 16 s).""
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -13,31 +16,8 @@ from hfgpu.proppant.analysis import row_profile
 from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.simulator import ProppantSimulation
 
-BOX = """
-[run]
-end_time = "16 s"
-physics = ["proppant"]
-seed = 3
-[fluid]
-viscosity = "1 cP"
-[mesh]
-cell_size = "2.5 mm"
-[output]
-every = "1 s"
-[geometry]
-kind = "box"
-length = "1 cm"
-height = "3 cm"
-width = "1 cm"
-[[proppant]]
-name = "sand"
-density = "2550 kg/m**3"
-diameter = "0.3 mm"
-initial_volume_fraction = 0.2
-[mppic]
-backend = "numpy"
-parcels_per_cell = 12
-"""
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
+from settled_bed import BOX  # noqa: E402
 
 
 def settle(text: str) -> ProppantSimulation:
