@@ -124,8 +124,9 @@ def initial_time(e_prime: float, mu_prime: float, k_prime: float, c_prime: float
     """(t0, a): the latest time at which a radial vertex solution reaches ``radius`` and its exponent a
     (R ~ t^a). Vertices (Savitski & Detournay 2002; Madyarova 2003): M R = 0.6955 (E' Q^3 t^4 / mu')^(1/9); K R = 0.8546
     (E' Q t / K')^(2/5); Mt = Kt R = 0.4502 (Q^2 t / C'^2)^(1/4). In float64 arithmetic: an absurd rate
-    (Q^3 past 1e308) gives t0 = 0, not an OverflowError from Python's float power."""
-    q = np.float64(q)
+    (Q^3 past 1e308) gives t0 = 0, and an absurd radius (R^9 past 1e308) t0 = inf, not an OverflowError from
+    Python's float power."""
+    q, radius = np.float64(q), np.float64(radius)
     with np.errstate(over="ignore"):
         times = [((radius / 0.6955) ** 9 * mu_prime / (e_prime * q**3)) ** 0.25, ]
         powers = [4.0 / 9.0]

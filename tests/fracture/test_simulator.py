@@ -124,6 +124,12 @@ def test_start_time_of_an_absurd_rate_is_zero_not_an_overflow():
     assert 0.6955 * (3e10 * 1e-6 * t0**4 / 12.0) ** (1.0 / 9.0) == pytest.approx(1.0, rel=1e-12)
 
 
+def test_start_time_of_an_absurd_radius_is_infinite_not_an_overflow():
+    """initial_time in float64: R^9 past 1e308 (cells of 5e33 m, found by the CLI fuzz test) gives t0 = inf."""
+    t0, _ = initial_time(3e10, 12.0, 1e6, 1e-6, 1e-2, 1.24e34)
+    assert t0 == float("inf")
+
+
 def test_newton_failure_raises_simulation_error_with_time_cell_and_residual():
     sc = scene(**FAST, fracture="[fracture]\nnewton_max_iterations = 1\nmax_step_retries = 1\n"
                                 "newton_tolerance = 1e-12")
