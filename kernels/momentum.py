@@ -38,7 +38,8 @@ def predict_x(u0: F64_2D, v0: F64_2D, p: F64_2D, width0: F64_2D, theta_f0: F64_2
               theta_f: F64_2D, mu: F64_2D, force_x: F64_2D, rho: ti.f64, dx: ti.f64, dz: ti.f64, dt: ti.f64,
               dean: ti.i32, u_star: F64_2D, d: F64_2D):
     """u* and d on the x-faces (Eq. 49 with Eq. 62-65, friction Eq. 9 and the u_P flux coefficients
-    point-implicit; dean = 1: Eq. 9 times Dean's f_t); walls and closed faces get 0."""
+    point-implicit, a closed corner a free-slip ghost; dean = 1: Eq. 9 times Dean's f_t); walls and closed faces
+    get 0."""
     nz, nx = width.shape[0], width.shape[1]
     for k, i in ti.ndrange((0, nz), (0, nx + 1)):
         us, dd = 0.0, 0.0
@@ -60,18 +61,21 @@ def predict_x(u0: F64_2D, v0: F64_2D, p: F64_2D, width0: F64_2D, theta_f0: F64_2
                                _old_q(width0, theta_f0, k, i - 1) * dz * 0.5 * (u0[k, i - 1] + u0[k, i]))
             diag = ce[0] + cw[1]
             nb = ce[1] * u0[k, i + 1] + cw[0] * u0[k, i - 1]
+            # a closed corner's free-slip ghost u_g = u_P: conductance of the face's own old width and viscosity
+            ghost = 0.0
+            if width0[k, i - 1] > 0.0 and width0[k, i] > 0.0:
+                ghost = 0.5 * (width0[k, i - 1] + width0[k, i]) * mu_f * dx / (rho * dz)
             # north face (corner of rows k-1, k), then south face (rows k, k+1)
             for side in ti.static(range(2)):
                 top = k - 1 + side
+                corner = False
                 if 0 <= top and top + 1 <= nz - 1:
-                    q_c, w_c, mu_c = 0.0, 0.0, 0.0
-                    if (width0[top, i - 1] > 0.0 and width0[top, i] > 0.0 and width0[top + 1, i - 1] > 0.0
-                            and width0[top + 1, i] > 0.0):
-                        q_c = 0.25 * (_old_q(width0, theta_f0, top, i - 1) + _old_q(width0, theta_f0, top, i)
-                                      + _old_q(width0, theta_f0, top + 1, i - 1)
-                                      + _old_q(width0, theta_f0, top + 1, i))
-                        w_c = 0.25 * (width0[top, i - 1] + width0[top, i] + width0[top + 1, i - 1]
-                                      + width0[top + 1, i])
+                    corner = (width0[top, i - 1] > 0.0 and width0[top, i] > 0.0 and width0[top + 1, i - 1] > 0.0
+                              and width0[top + 1, i] > 0.0)
+                if corner:
+                    q_c = 0.25 * (_old_q(width0, theta_f0, top, i - 1) + _old_q(width0, theta_f0, top, i)
+                                  + _old_q(width0, theta_f0, top + 1, i - 1) + _old_q(width0, theta_f0, top + 1, i))
+                    w_c = 0.25 * (width0[top, i - 1] + width0[top, i] + width0[top + 1, i - 1] + width0[top + 1, i])
                     mu_c = 0.25 * (mu[top, i - 1] + mu[top, i] + mu[top + 1, i - 1] + mu[top + 1, i])
                     c = _coefficients(w_c * mu_c * dx / (rho * dz),
                                       q_c * dx * 0.5 * (v0[top + 1, i - 1] + v0[top + 1, i]))
@@ -81,6 +85,9 @@ def predict_x(u0: F64_2D, v0: F64_2D, p: F64_2D, width0: F64_2D, theta_f0: F64_2
                     else:
                         diag += c[0]
                         nb += c[1] * u0[top + 1, i]
+                else:
+                    diag += ghost
+                    nb += ghost * u0[k, i]
             v_f = 0.25 * (v0[k, i - 1] + v0[k, i] + v0[k + 1, i - 1] + v0[k + 1, i])
             f_t = wall_friction_factor(ti.sqrt(u0[k, i] ** 2 + v_f ** 2), w_f, mu_f, rho, dean)
             a = q_f + dt / (dx * dz) * diag + dt * 12.0 * mu_f * f_t / (rho * w_f)

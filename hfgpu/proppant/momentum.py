@@ -28,9 +28,16 @@ as in the paper, and a steady state is exactly plane Poiseuille flow, u = -w^2/(
 pressure-correction coefficient d_P = dt w_P/(rho_f dx a_P) (u = u* + d_P (p'_W - p'_E)) is returned with u*.
 
 Conventions: (theta_f w) at a face is the mean of its two cells (0 unless both are open); at a corner of four
-cells (the z-faces of a u control volume) the mean of the four cells (0 unless all are open, which makes the
-domain's side walls and closed cells free-slip for in-plane viscous stress: the wall friction of the
-fracture faces is F_w); u at a cell centre is the mean of its two faces. The diffusion conductance
+cells (the z-faces of a u control volume) the mean of the four cells when all are open. A corner that is not
+(on the domain's walls, beside closed cells) is free-slip for the in-plane viscous stress (the wall friction of
+the fracture faces is F_w): its neighbour is the mirror ghost u_g = u_P, taken as the open corners' neighbours
+are, at the old level, with the conductance of the face's own old width and viscosity,
+D_g = w^o_f mu_f dx/(rho_f dz), added to sum c_P and D_g u^o_P to sum c_nb u^o_nb. Its flux D_g (u^o_P - u_P)
+vanishes in a steady state, as free slip must, and gives the point-implicit lag of a face on a wall the same
+weight as inside, so that a flow uniform along a wall stays uniform: without the ghost a face on a wall lags
+less while the flow changes (a settling suspension's backflow under its falling interface), and the difference
+drives a circulation along the walls (tests/proppant/test_momentum.py). u at a cell centre is the mean of its
+two faces. The diffusion conductance
 D = w mu_f dy/(rho_f delta) (Eq. 50-53, delta = the grid spacing) uses the old width. Walls and closed
 faces have u = 0. The z component is the same computation on the transposed grid.
 """
@@ -70,7 +77,11 @@ def _predict_x(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, rho, dx
     cl, cr = face_coefficients(d_c, f_c)
     diag = cl[:, 1:] + cr[:, :-1]
     nb = cr[:, 1:] * u0[:, 2:] + cl[:, :-1] * u0[:, :-2]
-    # south/north faces = corners of four cells (Eq. 52-53, 64-65), interior rows only
+    # south/north faces = corners of four cells (Eq. 52-53, 64-65); a closed corner is a free-slip ghost
+    u_in = u0[:, 1:-1]
+    ghost = (np.where(open0[:, :-1] & open0[:, 1:], 0.5 * (width0[:, :-1] + width0[:, 1:]), 0.0)
+             * mu_f * dx / (rho * dz))
+    walls = np.full((nz, nx - 1), 2.0)      # closed corners of each face control volume, north and south
     if nz > 1 and nx > 1:
         corner = open0[:-1, :-1] & open0[:-1, 1:] & open0[1:, :-1] & open0[1:, 1:]
         q_c = 0.25 * (q0[:-1, :-1] + q0[:-1, 1:] + q0[1:, :-1] + q0[1:, 1:])
@@ -79,11 +90,14 @@ def _predict_x(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, rho, dx
         f_z = np.where(corner, q_c, 0.0) * dx * 0.5 * (v0[1:-1, :-1] + v0[1:-1, 1:])
         d_z = np.where(corner, w_c, 0.0) * mu_c * dx / (rho * dz)
         cl_z, cr_z = face_coefficients(d_z, f_z)
-        u_in = u0[:, 1:-1]
         diag[1:] += cr_z      # north face of rows 1.. (P below the corner)
         diag[:-1] += cl_z     # south face of rows ..nz-2 (P above the corner)
         nb[1:] += cl_z * u_in[:-1]
         nb[:-1] += cr_z * u_in[1:]
+        walls[1:] -= corner
+        walls[:-1] -= corner
+    diag += walls * ghost
+    nb += walls * ghost * u_in
     v_f = 0.25 * (v0[:-1, :-1] + v0[:-1, 1:] + v0[1:, :-1] + v0[1:, 1:])  # v at the x-faces
     f_t = wall_friction_factor_numpy(np.sqrt(u0[:, 1:-1] ** 2 + v_f ** 2), w_f, mu_f, rho,
                                      wall_friction_code(wall_friction))
