@@ -7,11 +7,11 @@ Whitehouse (1997) at U = 0.22 m/s (the critical speed is 0.266 m/s) and 2.3 time
 Measured (NumPy backend, seed 0; by owning row k, the bed rows k = 4 (top) .. 7):
 - sub-critical, at 1 s, along the bed (x): the bed below its top cell at rest (0 m/s) with either bed stress,
   "overburden" or "grain" (with damping_scheme "implicit", whose lag holds a dense cell's mean, "grain" lets it
-  creep at up to 5.1e-5 m/s and "overburden" at 6.6e-7). The top cell, whose grains have the own-weight
+  creep at up to 4.9e-5 m/s and "overburden" at 1.0e-6). The top cell, whose grains have the own-weight
   friction under either closure, creeps at up to 1.6e-3 m/s (a grain is held where mu_b g' exceeds the drag
   D u_f of the fluid in the bed, D ~ 6e3 1/s: u_f < 0.6 mm/s).
-- supercritical, at 0.5 s, mean |u| with "overburden": the surface layer (k = 3, grains on the bed) 3.7e-2 m/s,
-  then 1.8e-3, 3.9e-4, 2.9e-6 and 0 down the bed: the surface moves as bed load, the interior does not follow.
+- supercritical, at 0.5 s, mean |u| with "overburden": the surface layer (k = 3, grains on the bed) 3.9e-2 m/s,
+  then 1.9e-3, 3.3e-4, 3.7e-6 and 0 down the bed: the surface moves as bed load, the interior does not follow.
 """
 
 from __future__ import annotations
@@ -85,9 +85,9 @@ def test_bed_under_subcritical_flow_is_at_rest_below_its_top_cell(bed_stress):
 
 def test_bed_surface_moves_above_the_critical_shields_stress():
     """Supercritical (Shields number 2-3 times the critical one), at 0.5 s: the grains on the bed (the row above
-    its top cell) move at a mean |u| > 1e-2 m/s (measured 3.7e-2), more than 20 times those of the bed's second
-    row (3.9e-4); the bed's top cell more than 3 times its second row (1.8e-3 against 3.9e-4), which is more
-    than 15 times its third (2.9e-6)."""
+    its top cell) move at a mean |u| > 1e-2 m/s (measured 3.9e-2), more than 20 times those of the bed's second
+    row (3.3e-4); the bed's top cell more than 3 times its second row (1.9e-3 against 3.3e-4), which is more
+    than 15 times its third (3.7e-6)."""
     sim = run_bed(0.6, "overburden", 0.5)
     k, ratio = rows_and_shields(sim)
     assert 2.0 < ratio < 3.0
