@@ -69,6 +69,19 @@ def test_overpacked_cell_warns_once_with_place_and_width():
         watch.after_step(1010.0, frame, width, theta)  # reported once
     assert watch.summary()["unphysical_states"].startswith("theta_p above close packing at t = 1 000 s")
 
+    assert "fracture history closes it" in watch.summary()["unphysical_states"]
+
+
+def test_overpacked_cell_of_a_fixed_width_names_placement_or_inflow():
+    """Without a width history (a slot, a box) the message does not blame the fracture's closing."""
+    watch = Watch(theta_cp=0.6, smallest_grain=100e-6, units="SI", width_history=False)
+    theta = np.zeros((3, 4))
+    theta[1, 2] = 0.78
+    with pytest.warns(RuntimeWarning, match=r"the width is fixed, so its parcels were placed there above close "
+                                            r"packing or one step's inflow overfilled it$"):
+        watch.after_step(2e-3, GridFrame(0.005, 0.005, 0.0, 0.0), np.full((3, 4), 5e-3), theta)
+    assert "fracture" not in watch.summary()["unphysical_states"]
+
 
 def test_close_packing_within_the_packing_cap_is_not_reported():
     """The push's packing cap lets a cell exceed theta_cp by one step's inflow (0.66 < 1.1 x 0.6)."""

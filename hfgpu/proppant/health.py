@@ -2,7 +2,8 @@
 
 * **theta_p above close packing**: the largest cell volume fraction above ``OVERPACKED`` x theta_cp (the packing
   cap of the push lets a cell exceed theta_cp by one step's inflow at most, so more means the width under the
-  parcels shrank: a closing cell of the width history);
+  parcels shrank: a closing cell of the width history; where the width is fixed, the parcels were placed there
+  above close packing or one step's inflow overfilled the cell);
 * **proppant in cells narrower than a grain**: a cell holding proppant (theta_p >= ``HOLDS``: more than the trace
   a neighbour's parcels deposit on it) whose width is below the smallest grain diameter of the scene's classes
   (parcels cannot enter such a cell, so its width shrank under them: a point parcel there stands for grains that
@@ -46,12 +47,14 @@ KEYS = {"dt_max": "[mppic] dt_max", "output": "[output] every or the schedule's 
 class Watch:
     """The checks of the module docstring for one run (times on the scene's clock); ``units`` is the scene's
     output system; ``stride`` > 0: the grid holds a stage's clusters side by side every ``stride`` columns
-    (hfgpu.stage_blocks), and a cell is named by its cluster and its x on that cluster's plane."""
+    (hfgpu.stage_blocks), and a cell is named by its cluster and its x on that cluster's plane;
+    ``width_history``: the width follows a fracture's history (False: fixed), which the messages name as a cause."""
 
     theta_cp: float
     smallest_grain: float
     units: str = "SI"
     stride: int = 0
+    width_history: bool = True
     found: dict[str, str] = field(default_factory=dict)
 
     def _where(self, frame, k: int, i: int) -> str:
@@ -76,11 +79,13 @@ class Watch:
         """Check the cell fields after an accepted step ending at ``t`` (the simulation's clock)."""
         k, i = np.unravel_index(int(np.argmax(theta)), theta.shape)
         if theta[k, i] > OVERPACKED * self.theta_cp and "theta_p above close packing" not in self.found:
+            cause = ("the width under its parcels shrank (the fracture history closes it); [coupling] "
+                     "fracture_every resolves the width history" if self.width_history else
+                     "the width is fixed, so its parcels were placed there above close packing or one step's "
+                     "inflow overfilled it")
             self._report("theta_p above close packing", t,
                          f"theta_p {theta[k, i]:.3g} (close packing {self.theta_cp:g}) in the cell at "
-                         f"{self._where(frame, k, i)}, {self._width(width[k, i])} wide: the width under its "
-                         "parcels shrank (the fracture history closes it); [coupling] fracture_every resolves the "
-                         "width history")
+                         f"{self._where(frame, k, i)}, {self._width(width[k, i])} wide: {cause}")
         narrow = (theta >= HOLDS) & (width > 0.0) & (width < self.smallest_grain)
         if narrow.any() and "proppant in cells narrower than a grain" not in self.found:
             k, i = np.argwhere(narrow)[0]
