@@ -23,7 +23,8 @@ class ProppantEngineSetup:
     ``start`` + k ``output_every`` and at the end. ``geometry`` is the domain the engine runs and its ports: the
     scene's ``[geometry]``, or a coupled run's field on the fracture's grid; a schedule's slurry enters through
     its inlets (a point at the perforation when it has none). ``schedule``: the injection on the scene's clock
-    (None: no inlet). ``cell_size``: (dx, dz) [m] of a box or slot grid (a field brings its own)."""
+    (None: no inlet). ``cell_size``: (dx, dz) [m] of a box or slot grid (a field brings its own). ``two_way``:
+    the scene's ``[coupling] mode`` is "two-way" (the fracture feels the slurry; the run's warnings say so)."""
 
     classes: tuple[ProppantClass, ...]
     params: MppicParams
@@ -37,6 +38,7 @@ class ProppantEngineSetup:
     output_every: float
     seed: int
     units: str                           # the unit system of its messages ([output] units)
+    two_way: bool = False
 
 
 def proppant_engine_setup(scene, geometry: Geometry | None = None, start: float = 0.0) -> ProppantEngineSetup:
@@ -52,4 +54,5 @@ def proppant_engine_setup(scene, geometry: Geometry | None = None, start: float 
     return ProppantEngineSetup(classes=proppant.classes, params=proppant.params, numerics=proppant.numerics,
                                geometry=geometry, fluid=scene.fluid, cell_size=(scene.mesh.dx, scene.mesh.dz),
                                schedule=schedule, start=start, end_time=scene.run.end_time,
-                               output_every=scene.output.every, seed=scene.run.seed, units=scene.output.units)
+                               output_every=scene.output.every, seed=scene.run.seed, units=scene.output.units,
+                               two_way=scene.coupling is not None and scene.coupling.mode == "two-way")

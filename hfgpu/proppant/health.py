@@ -48,13 +48,15 @@ class Watch:
     """The checks of the module docstring for one run (times on the scene's clock); ``units`` is the scene's
     output system; ``stride`` > 0: the grid holds a stage's clusters side by side every ``stride`` columns
     (hfgpu.stage_blocks), and a cell is named by its cluster and its x on that cluster's plane;
-    ``width_history``: the width follows a fracture's history (False: fixed), which the messages name as a cause."""
+    ``width_history``: the width follows a fracture's history (False: fixed), which the messages name as a cause;
+    ``two_way``: the fracture feels the slurry (``[coupling] mode = "two-way"``), so no message suggests it."""
 
     theta_cp: float
     smallest_grain: float
     units: str = "SI"
     stride: int = 0
     width_history: bool = True
+    two_way: bool = False
     found: dict[str, str] = field(default_factory=dict)
 
     def _where(self, frame, k: int, i: int) -> str:
@@ -92,8 +94,9 @@ class Watch:
             self._report("proppant in cells narrower than a grain", t,
                          f"theta_p {theta[k, i]:.3g} in the cell at {self._where(frame, k, i)}, "
                          f"{self._width(width[k, i])} wide, below the smallest grain "
-                         f"({self._width(self.smallest_grain)}); the cell is closing around its proppant, "
-                         "which a one-way coupled fracture does not feel ([coupling] mode = \"two-way\" does)")
+                         f"({self._width(self.smallest_grain)}); the cell is closing around its proppant"
+                         + ("" if self.two_way else ", which a one-way coupled fracture does not feel ([coupling] "
+                                                    "mode = \"two-way\" does)"))
 
     def check_step(self, t: float, dt: float, nominal: float, limits: dict[str, float], frame, fast_cell,
                    width: np.ndarray, theta: np.ndarray) -> None:

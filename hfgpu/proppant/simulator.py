@@ -214,7 +214,7 @@ class ProppantSimulation:
         self.safety = 1.0
         self.limited_by = "dt_max"
         self.watch = Watch(self.params.theta_cp, min(c.size.d_min for c in setup.classes), setup.units,
-                           width_history=width_field is not None)
+                           width_history=width_field is not None, two_way=setup.two_way)
         self.fluid_totals = dict.fromkeys(FLUID_VOLUMES, 0.0)
         self.next_out = setup.start   # the next snapshot's time (run, advance)
         self.max_residual = 0.0   # the largest continuity residual of the steps so far
