@@ -3,7 +3,7 @@ with the defaults ([mppic] grain_pressure "two-step", damping_scheme "relaxation
 the last fluid step's pressure under the implicit damping ("last", "implicit").
 
 Measured (docs/proppant-closures.md, "Pressure the grains take"): the defaults 1 parcel-snapshot faster than
-1 mm/s upward in cells at theta_p >= 0.5, at 1.2 mm/s; "last" with "implicit" 1 054, the fastest 106 mm/s."""
+1 mm/s upward in cells at theta_p >= 0.5, at 1.2 mm/s; "last" with "implicit" 700, the fastest 103 mm/s."""
 
 from __future__ import annotations
 
