@@ -27,19 +27,18 @@ Courant limit Eq. 42 still bounds dt, for the convective part and the particles)
 as in the paper, and a steady state is exactly plane Poiseuille flow, u = -w^2/(12 mu_f) dp/dx. The
 pressure-correction coefficient d_P = dt w_P/(rho_f dx a_P) (u = u* + d_P (p'_W - p'_E)) is returned with u*.
 
-Conventions: (theta_f w) at a face is the mean of its two cells (0 unless both are open); at a corner of four
-cells (the z-faces of a u control volume) the mean of the four cells when all are open. A corner that is not
-(on the domain's walls, beside closed cells) is free-slip for the in-plane viscous stress (the wall friction of
-the fracture faces is F_w): its neighbour is the mirror ghost u_g = u_P, taken as the open corners' neighbours
-are, at the old level, with the conductance of the face's own old width and viscosity,
-D_g = w^o_f mu_f dx/(rho_f dz), added to sum c_P and D_g u^o_P to sum c_nb u^o_nb. Its flux D_g (u^o_P - u_P)
-vanishes in a steady state, as free slip must, and gives the point-implicit lag of a face on a wall the same
-weight as inside, so that a flow uniform along a wall stays uniform: without the ghost a face on a wall lags
-less while the flow changes (a settling suspension's backflow under its falling interface), and the difference
-drives a circulation along the walls (tests/proppant/test_momentum.py). u at a cell centre is the mean of its
-two faces. The diffusion conductance
-D = w mu_f dy/(rho_f delta) (Eq. 50-53, delta = the grid spacing) uses the old width. Walls and closed
-faces have u = 0. The z component is the same computation on the transposed grid.
+Conventions: (theta_f w) at a face is the mean of its two cells (0 unless both are open); at a corner of four cells
+(the z-faces of a u control volume) the mean of the four cells when all are open. A corner that is not (on the
+domain's walls, beside closed cells) is free-slip for the in-plane viscous stress (the wall friction of the
+fracture faces is F_w): its neighbour is the mirror ghost u_g = u_P, taken as the open corners' neighbours are, at
+the old level, with the conductance of the face's own old width and viscosity, D_g = w^o_f mu_f dx/(rho_f dz),
+added to sum c_P and D_g u^o_P to sum c_nb u^o_nb. Its flux D_g (u^o_P - u_P) vanishes in a steady state, as free
+slip must, and gives the point-implicit lag of a face on a wall the same weight as inside, so that a flow uniform
+along a wall stays uniform: without the ghost a face on a wall lags less while the flow changes (a settling
+suspension's backflow under its falling interface), and the difference drives a circulation along the walls
+(tests/proppant/test_momentum.py). u at a cell centre is the mean of its two faces. The diffusion conductance D = w
+mu_f dy/(rho_f delta) (Eq. 50-53, delta = the grid spacing) uses the old width. Walls and closed faces have u = 0.
+The z component is the same computation on the transposed grid.
 """
 
 from __future__ import annotations
