@@ -78,8 +78,7 @@ def _predict_x(u0, v0, p, width0, theta_f0, width, theta_f, mu, force_x, rho, dx
     nb = cr[:, 1:] * u0[:, 2:] + cl[:, :-1] * u0[:, :-2]
     # south/north faces = corners of four cells (Eq. 52-53, 64-65); a closed corner is a free-slip ghost
     u_in = u0[:, 1:-1]
-    ghost = (np.where(open0[:, :-1] & open0[:, 1:], 0.5 * (width0[:, :-1] + width0[:, 1:]), 0.0)
-             * mu_f * dx / (rho * dz))
+    ghost = face_mean(width0, open0, axis=1)[:, 1:-1] * mu_f * dx / (rho * dz)
     walls = np.full((nz, nx - 1), 2.0)      # closed corners of each face control volume, north and south
     if nz > 1 and nx > 1:
         corner = open0[:-1, :-1] & open0[:-1, 1:] & open0[1:, :-1] & open0[1:, 1:]
