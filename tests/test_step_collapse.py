@@ -11,12 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from hfgpu import load_scene, scene_path
 from hfgpu.errors import SimulationError
 from hfgpu.io import plots
 from hfgpu.io.plots import status_banner
 from hfgpu.io.results import open_results
+from hfgpu.proppant.engine_setup import proppant_engine_setup
 from hfgpu.proppant.health import COLLAPSE_FLOOR, Watch
 from hfgpu.records import GridFrame
+from hfgpu.scene_text import edit_scene
 
 TINY = (Path(__file__).parent / "scenes" / "tiny_coupled.toml").read_text()
 
@@ -68,7 +71,6 @@ def test_overpacked_cell_warns_once_with_place_and_width():
         warnings.simplefilter("error")
         watch.after_step(1010.0, frame, width, theta)  # reported once
     assert watch.summary()["unphysical_states"].startswith("theta_p above close packing at t = 1 000 s")
-
     assert "fracture history closes it" in watch.summary()["unphysical_states"]
 
 
@@ -121,20 +123,17 @@ def test_proppant_in_a_cell_narrower_than_a_grain_warns_but_a_deposit_trace_does
 
 def test_a_two_way_run_is_not_told_to_run_two_way():
     """In a two-way run ([coupling] mode = "two-way") the narrow-cell warning does not suggest that mode."""
+    _, frame = _watch()
     watch = Watch(theta_cp=0.6, smallest_grain=100e-6, units="field", two_way=True)
     width = np.full((2, 3), 2e-3)
     width[0, 2] = 80e-6
     theta = np.zeros((2, 3))
     theta[0, 2] = 0.05
     with pytest.warns(RuntimeWarning, match=r"the cell is closing around its proppant$"):
-        watch.after_step(902.0, GridFrame(6.0, 6.0, 0.0, 3000.0), width, theta)
+        watch.after_step(902.0, frame, width, theta)
 
 
 def test_the_engine_setup_knows_a_two_way_scene():
-    from hfgpu import load_scene
-    from hfgpu.proppant.engine_setup import proppant_engine_setup
-    from hfgpu.scene_text import edit_scene
-
-    scene = load_scene(Path(__file__).resolve().parents[1] / "hfgpu" / "scenes" / "frac_pack_tso.toml")
+    scene = load_scene(scene_path("frac_pack_tso.toml"))
     assert proppant_engine_setup(edit_scene(scene, {"coupling.mode": "two-way"})).two_way
     assert not proppant_engine_setup(edit_scene(scene, {"coupling.mode": "one-way"})).two_way
