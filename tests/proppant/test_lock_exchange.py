@@ -8,11 +8,11 @@ along the floor at U = Fr sqrt(g' H), Fr = 1/2 for the energy-conserving Boussin
 Shin, Dalziel & Linden 2004, J. Fluid Mech. 521, 1-34, whose experiments at high Reynolds number run a few per
 cent below it), here Re = U H / nu ~ 3e4.
 
-Measured (heavy front fitted over 0.55-0.9 of the box, read to a cell): Fr = 0.447 with 1 cm cells and the
-default step, with either [mppic] grain_pressure and damping_scheme; the rest to 1/2 is the dissipation of the
-2-D first-order numerics at the current's head. Before the implicit drag coefficient took the parcels' own response into account
-(hfgpu.proppant.simulator, parcel_response) the suspension was anchored to the fluid's old velocity (inertia
-rho_f + beta dt, beta dt ~ 2e4 kg/m^3 at dt ~ 10 ms): Fr = 0.03, the front 2 cm from the gate at 2 s.
+Measured (heavy front fitted over 0.55-0.9 of the box, read to a cell): Fr = 0.447 with 1 cm cells and the default
+step, with either [mppic] grain_pressure and damping_scheme; the rest to 1/2 is the dissipation of the 2-D
+first-order numerics at the current's head. Before the implicit drag coefficient took the parcels' own response
+into account (hfgpu.proppant.simulator, parcel_response) the suspension was anchored to the fluid's old velocity
+(inertia rho_f + beta dt, beta dt ~ 2e4 kg/m^3 at dt ~ 10 ms): Fr = 0.03, the front 2 cm from the gate at 2 s.
 """
 
 from __future__ import annotations
