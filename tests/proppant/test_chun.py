@@ -43,9 +43,9 @@ def test_slot_scene_matches_the_experiment():
                           "0.55-0.57, +28 / +26 / +26 %), within 15 % from 20 s and 2.4 % at 30 s; bank AREA +24 % at "
                           "10 s, within 2.1 % from 20 s (python demos/slot.py). The length follows the grains' "
                           "settling speed (Wen-Yu / Schiller-Naumann, "
-                          "6.7 cm/s at 0.45 mm): 15 % faster settling gives 0.594 (+8 %) and Stokes' law 0.328 "
-                          "(-40 %). GEOS's reference model meets the experiment's length with Stokes settling, "
-                          "2.6x too fast. One-way coupling, mono-size 0.45 mm grains, wall friction, parcels, "
+                          "6.7 cm/s at 0.45 mm): Stokes' law (drag_re_coefficient = 0, 2.6x faster) gives 0.344 "
+                          "at 10 s (-37.5 %). GEOS's reference model meets the experiment's length with Stokes "
+                          "settling. One-way coupling, mono-size 0.45 mm grains, wall friction, parcels, "
                           "steps, grid, bank threshold and bed rules do not explain it; docs/proppant-closures.md "
                           "has the measurements.",
                    strict=False)
