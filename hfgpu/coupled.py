@@ -267,7 +267,7 @@ def simulate(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] 
     "fracture_snapshots", the fracture snapshots the results file kept (the history before the checkpoint).
     """
     if scene.coupling.mode == "two-way":
-        return simulate_two_way(scene, sink, progress, timings)
+        return simulate_two_way(scene, sink, progress, timings, checkpoint, resume)
     timings = timings if timings is not None else Timings()
     start = proppant_start_time(scene)
     cfg = scene.coupling
@@ -329,7 +329,7 @@ def proppant_phase(sim: ProppantSimulation, risk: _BridgingRisk, start: float, f
 
 
 def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float], None] | None = None,
-                     timings: Timings | None = None) -> dict:
+                     timings: Timings | None = None, checkpoint=None, resume: dict | None = None) -> dict:
     """The two-way coupled run (``[coupling] mode = "two-way"``): the paper's Fig. 4 with the arrow back.
 
     1. The proppant grid: the footprint of the fracture pumped with clean fluid (a pass without output, the
@@ -345,31 +345,51 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
        largest net pressure after it less the net pressure then, NaN without one) and ``packed_length`` (the
        length of fracture whose column holds a packed cell at the end).
 
-    No checkpoints (a two-way run restarts from the beginning); ``progress(t)`` follows the fracture.
+    Checkpoints (hfgpu.io.checkpoint): at the first interval end at or past each checkpoint time, after the
+    slurry is handed over, ``checkpoint`` gets {"phase": "two-way", "grid" (the proppant frame and shape),
+    "start", "fracture" (FractureRun's state), "proppant" (the proppant run's, on the scene's clock),
+    "screen_out" (the bridging counters), "tip" (the tip screen-out's time, net pressure then and largest net
+    pressure since)}; ``resume`` is such a state plus "fracture_snapshots" (the history the results file kept).
+    A resumed run skips the footprint pass and the pad, restores both runs, hands the fracture the slurry of
+    the restored proppant and goes on with the same steps as an uninterrupted run. ``progress(t)`` follows the
+    fracture.
     """
     timings = timings if timings is not None else Timings()
     timings.seconds.update(footprint=0.0, feedback=0.0)
     cfg, params = scene.coupling, scene.proppant.params
     fracture_setup = fracture_engine_setup(scene, every=cfg.fracture_every)
-    with timings.measure("footprint"):
-        clean = _Snapshots()
-        FractureRun(fracture_setup, clean).advance(fracture_setup.end_time)
-        history = FractureHistory(clean.snapshots)
-        start = late_start(scene, proppant_start_time(scene), float(history.times[0]))
-        frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=injection_cell_centre(scene))
+    if resume is None:
+        with timings.measure("footprint"):
+            clean = _Snapshots()
+            FractureRun(fracture_setup, clean).advance(fracture_setup.end_time)
+            history = FractureHistory(clean.snapshots)
+            start = late_start(scene, proppant_start_time(scene), float(history.times[0]))
+            frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=injection_cell_centre(scene))
+    else:
+        grid = resume["grid"]
+        frame = GridFrame(*(float(grid[name]) for name in ("dx", "dz", "x0", "z0")))
+        shape, start = (int(grid["nz"]), int(grid["nx"])), float(resume["start"])
 
     tee = _FractureTee(sink, timings)
-    run: FractureEngine = FractureRun(fracture_setup, tee, progress)
-    with timings.measure("fracture"):
-        run.advance(start)
+    if resume is not None:
+        tee.snapshots = list(resume["fracture_snapshots"])
+    run: FractureEngine = FractureRun(fracture_setup, tee, progress, resume=resume and resume["fracture"])
+    if resume is None:
+        with timings.measure("fracture"):
+            run.advance(start)
     geometry = {"width": FractureHistory(tee.snapshots).width_field(frame, shape, cfg.min_width)}
     sim: ProppantEngine = proppant_simulation(scene, frame, shape, start, lambda t: geometry["width"](t))
     risk = _BridgingRisk(sink, params.bridging_factor, timings)
+    t_screen_out, p_screen_out, p_max = math.nan, math.nan, -math.inf
+    if resume is not None:
+        sim.resume(resume["proppant"])
+        risk.restore(resume["screen_out"])
+        t_screen_out, p_screen_out, p_max = (float(resume["tip"][name]) for name in ("time", "net_pressure", "max"))
+        run.use_slurry(slurry_of(sim.snapshot(), params))
     every = cfg.fracture_every
     ends = [every * k for k in range(int(math.floor(start / every + 1e-9)) + 1,
                                      int(math.floor(scene.run.end_time / every + 1e-9)) + 1)]
-    ends = sorted({t for t in ends if t > start} | {scene.run.end_time})
-    t_screen_out, p_screen_out, p_max = math.nan, math.nan, -math.inf
+    ends = sorted({t for t in ends if t > max(start, sim.time)} | {scene.run.end_time})
     for t_next in ends:
         with timings.measure("fracture"):
             run.advance(t_next)
@@ -382,6 +402,13 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
             t_screen_out, p_screen_out = t_next, p_net
         if not math.isnan(t_screen_out):
             p_max = max(p_max, p_net)
+        if checkpoint is not None and checkpoint.due(t_next) and t_next < scene.run.end_time:
+            checkpoint.save(t_next, {
+                "phase": "two-way", "start": start, "fracture": run.state(),
+                "grid": {"dx": frame.dx, "dz": frame.dz, "x0": frame.x0, "z0": frame.z0, "nz": shape[0],
+                         "nx": shape[1]},
+                "proppant": sim.checkpoint_state(),
+                "screen_out": risk.state(), "tip": {"time": t_screen_out, "net_pressure": p_screen_out, "max": p_max}})
     proppant = sim.finish(risk)
     timings.add(sim.seconds)
     warn_screen_out(proppant, params.theta_cp)

@@ -18,7 +18,7 @@ proppant's prefixed ``proppant_``, and per cluster ``cluster_<i>_solid`` (proppa
 [m^3]), ``cluster_<i>_solid_share`` (its share of the proppant in the stage), ``cluster_<i>_propped_area``
 (cells whose proppant would cover the width when closed, hfgpu.propped.propped_cells) and
 ``cluster_<i>_created_area`` (open cells of its block). The closure after the run adds each cluster's
-conductivity values (hfgpu.runner). Checkpoints as the single fracture's coupled run; no two-way mode.
+conductivity values (hfgpu.runner). Checkpoints as the single fracture's one-way coupled run; no two-way mode.
 """
 
 from __future__ import annotations

@@ -34,6 +34,9 @@ class FractureEngine(Protocol):
     def summary(self) -> dict[str, Any]:
         """The run's summary so far."""
 
+    def state(self) -> dict[str, Any]:
+        """A checkpoint: what a run built with it as ``resume`` continues from."""
+
 
 @runtime_checkable
 class ProppantEngine(Protocol):
@@ -56,3 +59,9 @@ class ProppantEngine(Protocol):
 
     def finish(self, sink: ProppantSink) -> dict[str, Any]:
         """The last snapshot (unless one was just written) and the run's summary."""
+
+    def checkpoint_state(self) -> dict[str, Any]:
+        """A checkpoint: what :meth:`resume` continues from."""
+
+    def resume(self, state: dict[str, Any]) -> None:
+        """Continue from a :meth:`checkpoint_state` (the run freshly built from the same setup)."""

@@ -564,10 +564,15 @@ class FractureRun:
                     eng.coarsen_if_wide()
                 self.dt = eng.next_dt(self.dt if taken == step else taken)
                 if self.checkpoint is not None and self.checkpoint.due(eng.t):
-                    self.checkpoint.save(eng.t, {"engine": eng.state(), "dt": self.dt, "target": self.index})
+                    self.checkpoint.save(eng.t, self.state())
             if target < targets[self.index]:
                 return
             self.index += 1
+
+    def state(self) -> dict:
+        """What a checkpoint stores (:func:`simulate`), the ``resume`` that continues from now: {"engine", "dt",
+        "target"}."""
+        return {"engine": self.engine.state(), "dt": self.dt, "target": self.index}
 
     def summary(self) -> dict:
         """The run's summary (:func:`simulate`)."""

@@ -421,10 +421,19 @@ class ProppantSimulation:
         ``checkpoint.save(time, state)`` gets {"simulation": :meth:`state`, "next_out", "max_residual"};
         ``resume`` (such a state) continues from it, with the same steps as an uninterrupted run."""
         if resume is not None:
-            self.restore(resume["simulation"])
-            self.next_out, self.max_residual = resume["next_out"], resume["max_residual"]
+            self.resume(resume)
         self.advance(self.setup.end_time, sink, progress, on_step, checkpoint)
         return self.finish(sink)
+
+    def checkpoint_state(self) -> dict:
+        """What a checkpoint of the run stores (:meth:`run`): {"simulation": :meth:`state`, "next_out",
+        "max_residual"}."""
+        return {"simulation": self.state(), "next_out": self.next_out, "max_residual": self.max_residual}
+
+    def resume(self, state: dict) -> None:
+        """Continue from a :meth:`checkpoint_state`."""
+        self.restore(state["simulation"])
+        self.next_out, self.max_residual = state["next_out"], state["max_residual"]
 
     def advance(self, until: float, sink: ProppantSink, progress: Callable[[float], None] | None = None,
                 on_step: Callable[[StepInfo], None] | None = None, checkpoint=None) -> None:
@@ -452,8 +461,7 @@ class ProppantSimulation:
                 progress(self.time)
                 show_limit(progress, info.dt, self.limited_by)
             if checkpoint is not None and checkpoint.due(self.time):
-                checkpoint.save(self.time, {"simulation": self.state(), "next_out": self.next_out,
-                                            "max_residual": self.max_residual})
+                checkpoint.save(self.time, self.checkpoint_state())
 
     def finish(self, sink: ProppantSink) -> dict:
         """The last snapshot (unless one was just written) and the run's summary (:meth:`run`)."""

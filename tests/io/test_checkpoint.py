@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 import hfgpu
+import hfgpu.coupled as coupled
 from hfgpu import HfgpuError, SceneError, load_scene, open_results
 from hfgpu.io.checkpoint import (DEFAULT_CHECKPOINTS, Checkpointer, checkpoint_interval, read_tree,
                                  scene_differences, write_tree)
@@ -244,6 +245,33 @@ def test_a_coupled_checkpoint_on_the_proppant_clock_resumes(reference, tmp_path,
     hfgpu.run(load_scene(COUPLED), path, progress=False, resume=True)
     _assert_same_results(reference["coupled"], path, rtol=1e-9)
     assert open_results(path).summary["proppant_steps"] == open_results(reference["coupled"]).summary["proppant_steps"]
+
+
+#: COUPLED two-way (hfgpu.coupled.simulate_two_way): checkpoints at the 5 s interval ends only.
+TWO_WAY = COUPLED.replace('fracture_every = "5 s"', 'fracture_every = "5 s"\nmode = "two-way"')
+
+
+def test_two_way_run_resumes_from_an_interval_end(tmp_path, monkeypatch):
+    """A two-way run killed after its checkpoint at 30 s (an interval end, the slurry handed over) resumes without
+    the footprint pass and the pad and ends with the records and summary of the uninterrupted run, bit for bit:
+    the fracture and the proppant restored, the fracture given the slurry of the restored proppant."""
+    plain, path = tmp_path / "plain.h5", tmp_path / "resumed.h5"
+    hfgpu.run(load_scene(_no_checkpoints(TWO_WAY)), plain, progress=False)
+    _interrupted(monkeypatch, TWO_WAY, path, 1, 1)
+    with h5py.File(path, "r", locking=False) as f:
+        assert f["checkpoint/state"].attrs["phase"] == "two-way" and f["checkpoint"].attrs["time"] == 30.0
+    calls = []
+    with monkeypatch.context() as m:   # the resumed run builds no footprint: its only FractureRun is resumed
+        init = coupled.FractureRun.__init__
+        m.setattr(coupled.FractureRun, "__init__",
+                  lambda self, *a, **k: calls.append(k.get("resume") is not None) or init(self, *a, **k))
+        summary = hfgpu.run(load_scene(TWO_WAY), path, progress=False, resume=True)
+    assert calls == [True] and summary["resumed_from"] == 30.0
+    _assert_same_results(plain, path)
+    ref, got = open_results(plain).summary, open_results(path).summary
+    for key in ("fracture_steps", "proppant_steps", "proppant_injected", "proppant_in_domain", "packed_length",
+                "tip_screen_out_time", "net_pressure_rise", "screen_out_cells_max", "efficiency"):
+        assert got[key] == ref[key] or (math.isnan(got[key]) and math.isnan(ref[key])), key
 
 
 #: COUPLED as a stage of two clusters 30 m apart (hfgpu.coupled_stage), twice the rate.
