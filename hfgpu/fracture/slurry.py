@@ -60,12 +60,15 @@ class Slurry:
 
 
 def held_tips(active: np.ndarray, blocked: np.ndarray | None) -> int:
-    """Blocked active cells whose neighbour along x (the fracture's length) is inactive: where a bridged or
-    packed slurry holds the front's lateral tip (a tip screen-out); 0 without blocked cells."""
+    """Active cells at the front's lateral tip that the slurry holds (a tip screen-out): a blocked cell whose
+    neighbour along x (the fracture's length) is inactive or beyond the box, or a cell whose inactive neighbour
+    along x is blocked (the cell the front would open next, which it does not open: front.cells_to_open); 0
+    without blocked cells."""
     if blocked is None:
         return 0
-    tip = np.zeros_like(active)
-    tip[:, 1:] |= ~active[:, :-1]
-    tip[:, :-1] |= ~active[:, 1:]
-    tip[:, [0, -1]] = True
-    return int((active & blocked & tip).sum())
+    outside = np.ones((2,) + active.shape, dtype=bool)        # the neighbour to the left, to the right is inactive
+    outside[0, :, 1:], outside[1, :, :-1] = ~active[:, :-1], ~active[:, 1:]
+    beyond = np.zeros((2,) + active.shape, dtype=bool)        # ... and blocked
+    beyond[0, :, 1:], beyond[1, :, :-1] = blocked[:, :-1], blocked[:, 1:]
+    held = (blocked & outside.any(axis=0)) | (outside & beyond).any(axis=0)
+    return int((active & held).sum())

@@ -17,7 +17,7 @@ import pytest
 
 from hfgpu.fracture.mesh import injection_cell_centre
 from hfgpu.fracture.simulator import simulate
-from hfgpu.fracture.slurry import Slurry
+from hfgpu.fracture.slurry import Slurry, held_tips
 from hfgpu.proppant.closures import slurry_viscosity
 from hfgpu.proppant.params import MppicParams
 from hfgpu.records import GridFrame, MemorySink
@@ -128,3 +128,22 @@ def test_after_shut_in_the_walls_close_onto_the_pack():
     # after shut-in, and its new cells hold their film)
     assert propped <= out["stored"] <= 1.15 * propped
     assert (last >= floor * (1 - 1e-9)).sum() >= (shut_in >= floor).sum()
+
+
+def test_held_tips_counts_blocked_tip_cells_and_tip_cells_facing_a_blocked_cell():
+    """A tip screen-out is held by a blocked cell at the lateral tip or by the blocked cell just beyond it (the one
+    the front would open next); blocked cells inside the fracture, above or below it, or none, hold nothing."""
+    active = np.zeros((3, 8), dtype=bool)
+    active[:, 2:6] = True                                      # columns 2-5 open, tips at 2 and 5
+    blocked = np.zeros_like(active)
+    assert held_tips(active, None) == 0 and held_tips(active, blocked) == 0
+    blocked[0, 3:5] = True                                     # inside the fracture: not a tip
+    assert held_tips(active, blocked) == 0
+    blocked[1, 5] = True                                       # a blocked tip cell
+    assert held_tips(active, blocked) == 1
+    blocked[2, 1] = True                                       # beyond the left tip of row 2 (inactive, blocked)
+    assert held_tips(active, blocked) == 2
+    blocked[0, 7] = True                                       # blocked but not next to the front
+    assert held_tips(active, blocked) == 2
+    whole = np.ones((1, 4), dtype=bool)                        # the box's ends are the tips of a full row
+    assert held_tips(whole, np.array([[True, False, False, False]])) == 1
