@@ -358,6 +358,8 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
     timings.seconds.update(footprint=0.0, feedback=0.0)
     cfg, params = scene.coupling, scene.proppant.params
     fracture_setup = fracture_engine_setup(scene, every=cfg.fracture_every)
+    tee = _FractureTee(sink, timings)
+    run: FractureEngine
     if resume is None:
         with timings.measure("footprint"):
             clean = _Snapshots()
@@ -365,18 +367,14 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
             history = FractureHistory(clean.snapshots)
             start = late_start(scene, proppant_start_time(scene), float(history.times[0]))
             frame, shape = proppant_frame(history, cfg.cell_size, cfg.margin, source=injection_cell_centre(scene))
-    else:
-        grid = resume["grid"]
-        frame = GridFrame(*(float(grid[name]) for name in ("dx", "dz", "x0", "z0")))
-        shape, start = (int(grid["nz"]), int(grid["nx"])), float(resume["start"])
-
-    tee = _FractureTee(sink, timings)
-    if resume is not None:
-        tee.snapshots = list(resume["fracture_snapshots"])
-    run: FractureEngine = FractureRun(fracture_setup, tee, progress, resume=resume and resume["fracture"])
-    if resume is None:
+        run = FractureRun(fracture_setup, tee, progress)
         with timings.measure("fracture"):
             run.advance(start)
+    else:
+        grid = resume["grid"]
+        frame, shape, start = GridFrame.of(grid), (int(grid["nz"]), int(grid["nx"])), float(resume["start"])
+        tee.snapshots = list(resume["fracture_snapshots"])
+        run = FractureRun(fracture_setup, tee, progress, resume=resume["fracture"])
     geometry = {"width": FractureHistory(tee.snapshots).width_field(frame, shape, cfg.min_width)}
     sim: ProppantEngine = proppant_simulation(scene, frame, shape, start, lambda t: geometry["width"](t))
     risk = _BridgingRisk(sink, params.bridging_factor, timings)
@@ -405,8 +403,7 @@ def simulate_two_way(scene: Scene, sink: ResultsSink, progress: Callable[[float]
         if checkpoint is not None and checkpoint.due(t_next) and t_next < scene.run.end_time:
             checkpoint.save(t_next, {
                 "phase": "two-way", "start": start, "fracture": run.state(),
-                "grid": {"dx": frame.dx, "dz": frame.dz, "x0": frame.x0, "z0": frame.z0, "nz": shape[0],
-                         "nx": shape[1]},
+                "grid": {**dataclasses.asdict(frame), "nz": shape[0], "nx": shape[1]},
                 "proppant": sim.checkpoint_state(),
                 "screen_out": risk.state(), "tip": {"time": t_screen_out, "net_pressure": p_screen_out, "max": p_max}})
     proppant = sim.finish(risk)

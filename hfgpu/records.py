@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -32,6 +32,12 @@ class GridFrame:
     def centres(self, nz: int, nx: int) -> tuple[np.ndarray, np.ndarray]:
         """(x, z) cell-centre coordinates, each 1-D."""
         return self.x0 + self.dx * np.arange(nx), self.z0 + self.dz * np.arange(nz)
+
+    @classmethod
+    def of(cls, values) -> "GridFrame":
+        """The frame stored as a mapping with the keys dx, dz, x0, z0 (an HDF5 group's attributes, a checkpoint's
+        group)."""
+        return cls(**{f.name: float(values[f.name]) for f in fields(cls)})
 
 
 @dataclass(frozen=True)

@@ -186,7 +186,7 @@ def read_ensemble(path: str | Path) -> dict[str, Any]:
         propped = None
         if "propped" in f:
             g = f["propped"]
-            frame = GridFrame(**{k: float(g.attrs[k]) for k in ("dx", "dz", "x0", "z0")})
+            frame = GridFrame.of(g.attrs)
             propped = dict(frame=frame, fraction=g["fraction"][()], members=int(g.attrs["members"]))
         return dict(rows=rows, columns=header, metrics=metrics, inputs=header[2:len(header) - len(metrics) - 1],
                     percentiles={m: f["percentiles"][m][()] for m in metrics}, propped=propped, units=units)

@@ -757,8 +757,7 @@ def _snapshots(f: h5py.File, path: Path, physics: str, build: Callable) -> Snaps
 
 
 def _frame(group: h5py.Group) -> GridFrame:
-    a = group.attrs
-    return GridFrame(dx=float(a["dx"]), dz=float(a["dz"]), x0=float(a["x0"]), z0=float(a["z0"]))
+    return GridFrame.of(group.attrs)
 
 
 def _fracture_snapshot(group: h5py.Group) -> FractureSnapshot:
